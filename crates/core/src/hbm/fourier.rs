@@ -1,0 +1,275 @@
+//! Truncated Fourier series and the alternating frequency/time passage (paper Eqs. 13, 15).
+//!
+//! # Conventions (the one place they are written down)
+//!
+//! A periodic signal of fundamental circular frequency Ω is, with θ = Ωt,
+//!
+//! ```text
+//! x(θ) = c0 + Σ_{k=1..N} ( c_k cos kθ + s_k sin kθ )
+//! ```
+//!
+//! and its **coefficient vector** is `[c0, c1, s1, c2, s2, ..., cN, sN]` (length `2N+1`). The
+//! paper orders each pair (sin, cos) (`[B0 A1 B1 ...]`, Eq. 15); stickslip orders (cos, sin).
+//! Coefficient index of `cos kθ` is `2k−1`, of `sin kθ` is `2k` (k ≥ 1).
+//!
+//! For several DOFs the coefficients are stored **coefficient-major**: entry `j·n + i` is
+//! coefficient `j` of DOF `i` (a column-major `n × (2N+1)` matrix, one column per coefficient),
+//! so the linear operator of Eq. 17 is block diagonal in pairs of columns.
+//!
+//! Time samples are `θ_j = 2π j / n_t`, `j = 0..n_t`. Complex amplitude of harmonic k is
+//! `X_k = c_k − i s_k`, so that `x = c0 + Re Σ X_k e^{ikθ}`.
+
+use std::sync::Arc;
+
+use faer::Mat;
+use realfft::num_complex::Complex;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+
+/// Index of the cosine coefficient of harmonic `k ≥ 1` in a coefficient vector.
+#[inline]
+pub fn cos_index(k: usize) -> usize {
+    2 * k - 1
+}
+
+/// Index of the sine coefficient of harmonic `k ≥ 1` in a coefficient vector.
+#[inline]
+pub fn sin_index(k: usize) -> usize {
+    2 * k
+}
+
+/// Errors building a Fourier plan.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum FourierError {
+    #[error("{n_samples} time samples cannot resolve {n_harmonics} harmonics without aliasing: use at least {min} samples per period (paper: 300 for N = 7)")]
+    TooFewSamples { n_harmonics: usize, n_samples: usize, min: usize },
+    #[error("the number of harmonics must be at least 1, got 0")]
+    NoHarmonics,
+}
+
+/// Planned real FFTs and the synthesis/projection matrices for `N` harmonics and `n_t` samples.
+///
+/// Built once per (N, n_t) and shared (`Send + Sync`, `&self` evaluation); temporaries live in
+/// a caller-owned [`AftScratch`] so that evaluation never allocates.
+pub struct AftPlan {
+    n_harmonics: usize,
+    n_samples: usize,
+    forward: Arc<dyn RealToComplex<f64>>,
+    inverse: Arc<dyn ComplexToReal<f64>>,
+    /// `E[(j, c)]`: value at sample j of basis function c (`n_t × (2N+1)`), x = E X.
+    synthesis: Mat<f64>,
+    /// `P[(c, j)]`: weight of sample j in coefficient c (`(2N+1) × n_t`), X = P x (exact for
+    /// band-limited signals, the DFT projection otherwise). `P E = I`.
+    projection: Mat<f64>,
+}
+
+impl std::fmt::Debug for AftPlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AftPlan").field("n_harmonics", &self.n_harmonics).field("n_samples", &self.n_samples).finish()
+    }
+}
+
+/// Caller-owned temporaries of an [`AftPlan`].
+pub struct AftScratch {
+    spectrum: Vec<Complex<f64>>,
+    fft_scratch: Vec<Complex<f64>>,
+    time: Vec<f64>,
+}
+
+impl AftPlan {
+    /// Plan for `n_harmonics` harmonics and `n_samples` samples per period; `n_samples` must
+    /// exceed `2 n_harmonics` so that harmonic N is resolved.
+    pub fn new(n_harmonics: usize, n_samples: usize) -> Result<Self, FourierError> {
+        if n_harmonics == 0 {
+            return Err(FourierError::NoHarmonics);
+        }
+        let min = 2 * n_harmonics + 1;
+        if n_samples < min {
+            return Err(FourierError::TooFewSamples { n_harmonics, n_samples, min });
+        }
+        let mut planner = RealFftPlanner::<f64>::new();
+        let forward = planner.plan_fft_forward(n_samples);
+        let inverse = planner.plan_fft_inverse(n_samples);
+        let nc = 2 * n_harmonics + 1;
+        let dtheta = 2.0 * std::f64::consts::PI / n_samples as f64;
+        let synthesis = Mat::from_fn(n_samples, nc, |j, c| basis(c, j as f64 * dtheta));
+        let projection = Mat::from_fn(nc, n_samples, |c, j| {
+            let w = if c == 0 { 1.0 } else { 2.0 };
+            w / n_samples as f64 * basis(c, j as f64 * dtheta)
+        });
+        Ok(AftPlan { n_harmonics, n_samples, forward, inverse, synthesis, projection })
+    }
+
+    pub fn n_harmonics(&self) -> usize {
+        self.n_harmonics
+    }
+
+    pub fn n_samples(&self) -> usize {
+        self.n_samples
+    }
+
+    /// Length of a coefficient vector, `2N + 1`.
+    pub fn n_coeffs(&self) -> usize {
+        2 * self.n_harmonics + 1
+    }
+
+    /// Synthesis matrix `E` (`n_t × (2N+1)`): `x_j = Σ_c E[(j,c)] X_c`.
+    pub fn synthesis(&self) -> &Mat<f64> {
+        &self.synthesis
+    }
+
+    /// Projection matrix `P` (`(2N+1) × n_t`): `X_c = Σ_j P[(c,j)] x_j`.
+    pub fn projection(&self) -> &Mat<f64> {
+        &self.projection
+    }
+
+    /// Temporaries for [`synthesize`](Self::synthesize) and [`analyze`](Self::analyze).
+    pub fn scratch(&self) -> AftScratch {
+        let len = self.forward.get_scratch_len().max(self.inverse.get_scratch_len());
+        AftScratch {
+            spectrum: vec![Complex::new(0.0, 0.0); self.n_samples / 2 + 1],
+            fft_scratch: vec![Complex::new(0.0, 0.0); len],
+            time: vec![0.0; self.n_samples],
+        }
+    }
+
+    /// Time samples `x(θ_j)` of the coefficient vector `coeffs` (inverse DFT of Eq. 15).
+    pub fn synthesize(&self, coeffs: &[f64], samples: &mut [f64], scratch: &mut AftScratch) {
+        self.synthesize_scaled(coeffs, samples, scratch, 0)
+    }
+
+    /// Samples of `dx/dθ` (multiply by Ω for the time derivative).
+    pub fn synthesize_derivative(&self, coeffs: &[f64], samples: &mut [f64], scratch: &mut AftScratch) {
+        self.synthesize_scaled(coeffs, samples, scratch, 1)
+    }
+
+    fn synthesize_scaled(&self, coeffs: &[f64], samples: &mut [f64], scratch: &mut AftScratch, derivative: u32) {
+        assert_eq!(coeffs.len(), self.n_coeffs(), "expected {} coefficients, got {}", self.n_coeffs(), coeffs.len());
+        assert_eq!(samples.len(), self.n_samples, "expected {} samples, got {}", self.n_samples, samples.len());
+        let spec = &mut scratch.spectrum;
+        spec.iter_mut().for_each(|z| *z = Complex::new(0.0, 0.0));
+        spec[0] = Complex::new(if derivative == 0 { coeffs[0] } else { 0.0 }, 0.0);
+        for k in 1..=self.n_harmonics {
+            // X_k = c_k − i s_k; the c2r transform sums X_0 + 2 Re Σ Y_k e^{ikθ}, so Y_k = X_k/2.
+            let z = Complex::new(coeffs[cos_index(k)], -coeffs[sin_index(k)]) * 0.5;
+            // d/dθ multiplies harmonic k by ik.
+            spec[k] = if derivative == 0 { z } else { z * Complex::new(0.0, k as f64) };
+        }
+        if self.n_samples % 2 == 0 {
+            // The Nyquist bin must be real for the c2r transform; it is zero here since N < n_t/2.
+            let last = spec.len() - 1;
+            spec[last].im = 0.0;
+        }
+        self.inverse
+            .process_with_scratch(spec, samples, &mut scratch.fft_scratch)
+            .expect("buffer sizes are fixed by the plan");
+    }
+
+    /// Coefficients of the first N harmonics of the samples (DFT of Eq. 15).
+    pub fn analyze(&self, samples: &[f64], coeffs: &mut [f64], scratch: &mut AftScratch) {
+        assert_eq!(coeffs.len(), self.n_coeffs(), "expected {} coefficients, got {}", self.n_coeffs(), coeffs.len());
+        assert_eq!(samples.len(), self.n_samples, "expected {} samples, got {}", self.n_samples, samples.len());
+        scratch.time.copy_from_slice(samples);
+        self.forward
+            .process_with_scratch(&mut scratch.time, &mut scratch.spectrum, &mut scratch.fft_scratch)
+            .expect("buffer sizes are fixed by the plan");
+        let scale = 1.0 / self.n_samples as f64;
+        coeffs[0] = scratch.spectrum[0].re * scale;
+        for k in 1..=self.n_harmonics {
+            let z = scratch.spectrum[k];
+            coeffs[cos_index(k)] = 2.0 * z.re * scale;
+            coeffs[sin_index(k)] = -2.0 * z.im * scale;
+        }
+    }
+}
+
+/// Basis function c at angle θ: 1, cos θ, sin θ, cos 2θ, ...
+#[inline]
+pub fn basis(c: usize, theta: f64) -> f64 {
+    if c == 0 {
+        1.0
+    } else {
+        let k = c.div_ceil(2) as f64;
+        if c % 2 == 1 {
+            (k * theta).cos()
+        } else {
+            (k * theta).sin()
+        }
+    }
+}
+
+/// Amplitude and phase of harmonic `k ≥ 1` of a coefficient vector: `x_k = A cos(kθ + φ)`,
+/// `A = |c_k − i s_k|`, `φ = arg(c_k − i s_k)` (so a pure sine has φ = −π/2).
+pub fn amplitude_phase(coeffs: &[f64], k: usize) -> (f64, f64) {
+    let c = coeffs[cos_index(k)];
+    let s = coeffs[sin_index(k)];
+    (c.hypot(s), (-s).atan2(c))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rel_err(a: &[f64], b: &[f64]) -> f64 {
+        let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt();
+        let den: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
+        num / den
+    }
+
+    #[test]
+    fn synthesis_and_analysis_are_inverse_and_match_the_matrices() {
+        // Odd and even sample counts, and the paper's 300.
+        for &(n, nt) in &[(1, 3), (3, 8), (7, 300), (5, 31)] {
+            let plan = AftPlan::new(n, nt).unwrap();
+            let mut s = plan.scratch();
+            let coeffs: Vec<f64> = (0..plan.n_coeffs()).map(|c| 0.3 + (c as f64 * 1.7).sin()).collect();
+            let mut x = vec![0.0; nt];
+            plan.synthesize(&coeffs, &mut x, &mut s);
+            // Direct evaluation of the series.
+            let direct: Vec<f64> = (0..nt)
+                .map(|j| {
+                    let th = 2.0 * std::f64::consts::PI * j as f64 / nt as f64;
+                    (0..plan.n_coeffs()).map(|c| coeffs[c] * basis(c, th)).sum()
+                })
+                .collect();
+            assert!(rel_err(&x, &direct) < 1e-13, "synthesis N={n} nt={nt}");
+            let mut back = vec![0.0; plan.n_coeffs()];
+            plan.analyze(&x, &mut back, &mut s);
+            assert!(rel_err(&back, &coeffs) < 1e-13, "analysis N={n} nt={nt}");
+            // P E = I.
+            let pe = plan.projection() * plan.synthesis();
+            for i in 0..plan.n_coeffs() {
+                for j in 0..plan.n_coeffs() {
+                    let expect = if i == j { 1.0 } else { 0.0 };
+                    assert!((pe[(i, j)] - expect).abs() < 1e-13);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn derivative_of_a_known_series() {
+        let plan = AftPlan::new(3, 64).unwrap();
+        let mut s = plan.scratch();
+        // x = 2 cos 2θ + 5 sin 3θ  →  x' = −4 sin 2θ + 15 cos 3θ.
+        let mut c = vec![0.0; 7];
+        c[cos_index(2)] = 2.0;
+        c[sin_index(3)] = 5.0;
+        let mut dx = vec![0.0; 64];
+        plan.synthesize_derivative(&c, &mut dx, &mut s);
+        for (j, v) in dx.iter().enumerate() {
+            let th = 2.0 * std::f64::consts::PI * j as f64 / 64.0;
+            let expect = -4.0 * (2.0 * th).sin() + 15.0 * (3.0 * th).cos();
+            assert!((v - expect).abs() < 1e-12);
+        }
+        let (a, phi) = amplitude_phase(&c, 3);
+        assert!((a - 5.0).abs() < 1e-15 && (phi + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn too_few_samples_is_an_error() {
+        assert_eq!(
+            AftPlan::new(7, 14).unwrap_err(),
+            FourierError::TooFewSamples { n_harmonics: 7, n_samples: 14, min: 15 }
+        );
+    }
+}

@@ -1,0 +1,57 @@
+use faer::{Mat, Side};
+
+use super::{LinearModel, ModelError};
+
+/// Undamped modes of `(K, M)`: `K φ_r = ω_r² M φ_r`, mass-normalised (`Φᵀ M Φ = I`), in
+/// increasing frequency order.
+#[derive(Clone, Debug)]
+pub struct Modes {
+    /// Circular frequencies ω_r in rad/s.
+    pub omega: Vec<f64>,
+    /// Mode shapes, one column per mode.
+    pub shapes: Mat<f64>,
+}
+
+impl Modes {
+    /// Frequencies in Hz.
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / (2.0 * std::f64::consts::PI)).collect()
+    }
+}
+
+impl LinearModel {
+    /// All modes of the model by a dense generalised symmetric eigensolution: `M = L Lᵀ`
+    /// (Cholesky), `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ`, `Φ = L⁻ᵀ Q`. Meant for reduced or small models (the
+    /// cost is O(n³)); FE-size models go through the sparse eigensolver of `stickslip-fe`.
+    ///
+    /// Errors when M is not positive definite or K has a non-positive eigenvalue (a rigid-body
+    /// motion, which makes the static harmonic of the balance singular).
+    pub fn dense_modes(&self) -> Result<Modes, ModelError> {
+        let n = self.n_dofs();
+        let m = self.mass.to_dense();
+        let k = self.stiffness.to_dense();
+        let llt = m.llt(Side::Lower).map_err(|_| ModelError::MassNotPositiveDefinite)?;
+        // A = L⁻¹ K L⁻ᵀ: solve L X = K, then L Aᵀ = Xᵀ (A symmetric).
+        let l = llt.L();
+        let mut x = k.clone();
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, x.as_mut(), faer::Par::Seq);
+        let mut a = x.transpose().to_owned();
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, a.as_mut(), faer::Par::Seq);
+        // Symmetrise round-off before the symmetric eigensolver.
+        let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let evd = a
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|_| ModelError::Invalid("the eigensolver of (K, M) did not converge".into()))?;
+        let lambda: Vec<f64> = (0..n).map(|i| evd.S()[i]).collect();
+        let scale = lambda.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        if let Some(&lowest) = lambda.first() {
+            // Eigenvalues below round-off of the largest are rigid-body modes.
+            if lowest <= 1e-12 * scale {
+                return Err(ModelError::StiffnessNotPositiveDefinite { lowest });
+            }
+        }
+        let mut shapes = evd.U().to_owned();
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), shapes.as_mut(), faer::Par::Seq);
+        Ok(Modes { omega: lambda.iter().map(|l| l.sqrt()).collect(), shapes })
+    }
+}
