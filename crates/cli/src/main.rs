@@ -1,1 +1,52 @@
-fn main() {}
+//! The `stickslip` command: argument parsing and progress only; the libraries do the work.
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod commands;
+
+#[derive(Parser)]
+#[command(
+    name = "stickslip",
+    version,
+    about = "Nonlinear vibration of assemblies with friction joints: harmonic balance, condensation, continuation"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Frequency response of a study at every force level (harmonic balance + continuation).
+    Run(commands::run::Args),
+    /// Lowest modes of a model (mesh, CalculiX deck or matrices).
+    Modes(commands::modes::Args),
+    /// Reduce a model (Craig-Bampton, free-mode variant, slipped-joint enrichment).
+    Reduce(commands::reduce::Args),
+    /// Direct time integration of a study: steady state at one frequency or swept sine.
+    Timesim(commands::timesim::Args),
+    /// Harmonics and FRFs from time records (CSV or UFF 58).
+    Extract(commands::extract::Args),
+    /// Measured against simulated FRFs: overlay plots, peak frequencies and amplitudes.
+    Compare(commands::compare::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => commands::run::main(a),
+        Command::Modes(a) => commands::modes::main(a),
+        Command::Reduce(a) => commands::reduce::main(a),
+        Command::Timesim(a) => commands::timesim::main(a),
+        Command::Extract(a) => commands::extract::main(a),
+        Command::Compare(a) => commands::compare::main(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

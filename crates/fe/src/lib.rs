@@ -1,1 +1,5 @@
-
+//! stickslip-fe: from a mesh to a (reduced) linear model (paper Section 3.1-3.3).
+//!
+//! Meshes in ([`mesh`]), finite elements and sparse assembly ([`assembly`]), the sparse
+//! eigensolver ([`eigen`]) and the reductions ([`reduction`]: Craig-Bampton, the paper's
+//! free-mode variant Eqs. 3-5, slipped-joint enrichment).

@@ -1,1 +1,1 @@
-
+//! stickslip-io: files in and out (study files, matrix formats, CSV/NPZ/UFF, plots).

@@ -59,7 +59,8 @@ impl Tangent {
 
     /// Set every entry to zero (laws only write their non-zero entries).
     pub fn clear(&mut self) {
-        for v in [&mut self.dg_du, &mut self.dg_dv, &mut self.dg_ds, &mut self.ds_du, &mut self.ds_dv, &mut self.ds_ds] {
+        for v in [&mut self.dg_du, &mut self.dg_dv, &mut self.dg_ds, &mut self.ds_du, &mut self.ds_dv, &mut self.ds_ds]
+        {
             v.iter_mut().for_each(|x| *x = 0.0);
         }
     }

@@ -98,7 +98,9 @@ impl LinearModel {
             }
         }
         match &self.damping {
-            Damping::Rayleigh { alpha, beta } if !(alpha.is_finite() && beta.is_finite() && *alpha >= 0.0 && *beta >= 0.0) => {
+            Damping::Rayleigh { alpha, beta }
+                if !(alpha.is_finite() && beta.is_finite() && *alpha >= 0.0 && *beta >= 0.0) =>
+            {
                 return Err(ModelError::Invalid(format!(
                     "Rayleigh damping needs finite alpha >= 0 and beta >= 0, got alpha = {alpha}, beta = {beta}"
                 )));
@@ -112,7 +114,11 @@ impl LinearModel {
         }
         for l in &self.loads {
             if l.values.len() != n {
-                return Err(ModelError::WrongLength { what: format!("load {:?}", l.name), len: l.values.len(), expected: n });
+                return Err(ModelError::WrongLength {
+                    what: format!("load {:?}", l.name),
+                    len: l.values.len(),
+                    expected: n,
+                });
             }
             if l.values.iter().any(|v| !v.is_finite()) {
                 return Err(ModelError::NotFinite { what: format!("load {:?}", l.name) });

@@ -6,9 +6,11 @@ mod dof;
 mod linear;
 mod matrix;
 mod modes;
+mod nonlinear;
 
 pub use damping::Damping;
 pub use dof::DofLabel;
 pub use linear::{LinearModel, ModelError, NamedVector};
 pub use matrix::Matrix;
 pub use modes::Modes;
+pub use nonlinear::{relative_direction, stiffness_along, ElementSite, NonlinearModel};

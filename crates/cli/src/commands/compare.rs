@@ -1,0 +1,9 @@
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input file.
+    pub input: std::path::PathBuf,
+}
+
+pub fn main(args: Args) -> anyhow::Result<()> {
+    anyhow::bail!("`stickslip compare` is not available yet (input {})", args.input.display())
+}

@@ -1,0 +1,6 @@
+pub mod compare;
+pub mod extract;
+pub mod modes;
+pub mod reduce;
+pub mod run;
+pub mod timesim;
