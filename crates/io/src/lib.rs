@@ -1,1 +1,2 @@
 //! stickslip-io: files in and out (study files, matrix formats, CSV/NPZ/UFF, plots).
+pub mod matrix;
