@@ -57,6 +57,8 @@ pub struct AftPlan {
     inverse: Arc<dyn ComplexToReal<f64>>,
     /// `E[(j, c)]`: value at sample j of basis function c (`n_t × (2N+1)`), x = E X.
     synthesis: Mat<f64>,
+    /// `E'[(j, c)]`: θ-derivative of basis function c at sample j, dx/dθ = E' X.
+    synthesis_derivative: Mat<f64>,
     /// `P[(c, j)]`: weight of sample j in coefficient c (`(2N+1) × n_t`), X = P x (exact for
     /// band-limited signals, the DFT projection otherwise). `P E = I`.
     projection: Mat<f64>,
@@ -92,11 +94,12 @@ impl AftPlan {
         let nc = 2 * n_harmonics + 1;
         let dtheta = 2.0 * std::f64::consts::PI / n_samples as f64;
         let synthesis = Mat::from_fn(n_samples, nc, |j, c| basis(c, j as f64 * dtheta));
+        let synthesis_derivative = Mat::from_fn(n_samples, nc, |j, c| basis_derivative(c, j as f64 * dtheta));
         let projection = Mat::from_fn(nc, n_samples, |c, j| {
             let w = if c == 0 { 1.0 } else { 2.0 };
             w / n_samples as f64 * basis(c, j as f64 * dtheta)
         });
-        Ok(AftPlan { n_harmonics, n_samples, forward, inverse, synthesis, projection })
+        Ok(AftPlan { n_harmonics, n_samples, forward, inverse, synthesis, synthesis_derivative, projection })
     }
 
     pub fn n_harmonics(&self) -> usize {
@@ -115,6 +118,11 @@ impl AftPlan {
     /// Synthesis matrix `E` (`n_t × (2N+1)`): `x_j = Σ_c E[(j,c)] X_c`.
     pub fn synthesis(&self) -> &Mat<f64> {
         &self.synthesis
+    }
+
+    /// Derivative synthesis matrix `E'` (`n_t × (2N+1)`): `dx/dθ(θ_j) = Σ_c E'[(j,c)] X_c`.
+    pub fn synthesis_derivative_matrix(&self) -> &Mat<f64> {
+        &self.synthesis_derivative
     }
 
     /// Projection matrix `P` (`(2N+1) × n_t`): `X_c = Σ_j P[(c,j)] x_j`.
@@ -193,6 +201,21 @@ pub fn basis(c: usize, theta: f64) -> f64 {
             (k * theta).cos()
         } else {
             (k * theta).sin()
+        }
+    }
+}
+
+/// θ-derivative of basis function c: 0, −sin θ, cos θ, −2 sin 2θ, ...
+#[inline]
+pub fn basis_derivative(c: usize, theta: f64) -> f64 {
+    if c == 0 {
+        0.0
+    } else {
+        let k = c.div_ceil(2) as f64;
+        if c % 2 == 1 {
+            -k * (k * theta).sin()
+        } else {
+            k * (k * theta).cos()
         }
     }
 }

@@ -1,0 +1,352 @@
+//! The harmonic balance condensed onto the nonlinear directions (paper Eqs. 16-30).
+//!
+//! Unknowns: the harmonics of `u = Vᵀ U` on the q application directions, coefficient-major
+//! (`x[c·q + i]`, see [`super::fourier`]): (2N+1)q unknowns whatever the model size. With
+//! `G(x)` the element forces' harmonics (AFT, Eq. 15) and, per harmonic k, `H_k = H(kΩ)` and
+//! `u_F,k` from [`Receptance`], the residual is
+//!
+//! ```text
+//! R_k = x_k − λ_F u_F,k δ_k1 + H_k G_k           (complex, x_k = c_k − i s_k)
+//! ```
+//!
+//! i.e. Eq. 29 premultiplied by the condensed flexibility `H_k = (A_qq − A_qp A_pp⁻¹ A_pq)⁻¹`,
+//! which the modal sum gives directly (no inversion) and which makes the residual a
+//! displacement, compared with the linear response amplitude. The excitation is
+//! `λ_F F cos Ωt` (Eq. 18: on the cosine of harmonic 1). In real form, for the pair (c, s):
+//!
+//! ```text
+//! [R_c]   [x_c]       [ Re u_F]   [ Re H   Im H] [G_c]
+//! [R_s] = [x_s] − λ_F [−Im u_F] + [−Im H   Re H] [G_s]
+//! ```
+
+use faer::{c64, Mat, MatMut};
+
+use super::element_aft::{AftError, ElementAft};
+use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
+use super::receptance::{HarmonicReceptance, Receptance};
+use crate::model::{ModelError, NonlinearModel};
+
+/// Numerical settings of the harmonic balance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HbmSettings {
+    /// Number of harmonics N (paper: 7).
+    pub harmonics: usize,
+    /// Time samples per period n_t of the AFT (paper: 300).
+    pub samples: usize,
+}
+
+impl Default for HbmSettings {
+    fn default() -> Self {
+        HbmSettings { harmonics: 7, samples: 300 }
+    }
+}
+
+/// Why a harmonic balance problem could not be set up or evaluated.
+#[derive(Debug, thiserror::Error)]
+pub enum HbmError {
+    #[error(transparent)]
+    Fourier(#[from] FourierError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Aft(#[from] AftError),
+    #[error("the model has no nonlinear element: nothing to condense on (a linear FRF needs no harmonic balance)")]
+    NoElements,
+    #[error("the excitation pattern has length {got}, expected {expected}")]
+    ForceLength { got: usize, expected: usize },
+}
+
+/// The condensed harmonic balance of a [`NonlinearModel`] under `λ_F F cos Ωt`.
+pub struct CondensedHbm<'m> {
+    model: &'m NonlinearModel,
+    plan: AftPlan,
+    receptance: Receptance,
+    force: Vec<f64>,
+    q: usize,
+    /// First global direction of each element.
+    offsets: Vec<usize>,
+    afts: Vec<ElementAft>,
+    harmonic: Vec<HarmonicReceptance>,
+    // Work buffers (no allocation per evaluation).
+    g: Vec<f64>,
+    dg: Mat<f64>,
+    dg_domega: Vec<f64>,
+    elem_u: Vec<Vec<f64>>,
+    elem_g: Vec<Vec<f64>>,
+    elem_jac: Vec<Mat<f64>>,
+    elem_dgdw: Vec<Vec<f64>>,
+    h0: Mat<f64>,
+    /// Number of residual (and Jacobian) evaluations since creation.
+    pub evaluations: usize,
+}
+
+impl<'m> CondensedHbm<'m> {
+    /// Set up the condensed balance of `model` excited by the pattern `force` (N per unit level).
+    pub fn new(model: &'m NonlinearModel, force: &[f64], settings: HbmSettings) -> Result<Self, HbmError> {
+        let n = model.linear.n_dofs();
+        if force.len() != n {
+            return Err(HbmError::ForceLength { got: force.len(), expected: n });
+        }
+        if model.elements.is_empty() {
+            return Err(HbmError::NoElements);
+        }
+        let plan = AftPlan::new(settings.harmonics, settings.samples)?;
+        let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
+        let receptance = Receptance::new(&model.linear, &directions, force)?;
+        let q = directions.len();
+        let nc = plan.n_coeffs();
+        let mut offsets = Vec::with_capacity(model.elements.len());
+        let mut off = 0;
+        for e in &model.elements {
+            offsets.push(off);
+            off += e.law.n_dirs();
+        }
+        let afts = model.elements.iter().map(|e| ElementAft::new(e.law.as_ref(), &plan)).collect();
+        let dims: Vec<usize> = model.elements.iter().map(|e| e.law.n_dirs() * nc).collect();
+        // Static receptance H(0) = Vᵀ K⁻¹ V (real).
+        let mut h = HarmonicReceptance::new(q);
+        receptance.evaluate(0.0, &mut h);
+        let h0 = Mat::from_fn(q, q, |i, j| h.h[(i, j)].re);
+        Ok(CondensedHbm {
+            model,
+            receptance,
+            force: force.to_vec(),
+            q,
+            offsets,
+            afts,
+            harmonic: (0..settings.harmonics).map(|_| HarmonicReceptance::new(q)).collect(),
+            g: vec![0.0; q * nc],
+            dg: Mat::zeros(q * nc, q * nc),
+            dg_domega: vec![0.0; q * nc],
+            elem_u: dims.iter().map(|&m| vec![0.0; m]).collect(),
+            elem_g: dims.iter().map(|&m| vec![0.0; m]).collect(),
+            elem_jac: dims.iter().map(|&m| Mat::zeros(m, m)).collect(),
+            elem_dgdw: dims.iter().map(|&m| vec![0.0; m]).collect(),
+            h0,
+            plan,
+            evaluations: 0,
+        })
+    }
+
+    /// Number of unknowns (2N+1)q.
+    pub fn dimension(&self) -> usize {
+        self.q * self.plan.n_coeffs()
+    }
+
+    /// Number of nonlinear directions q.
+    pub fn n_directions(&self) -> usize {
+        self.q
+    }
+
+    pub fn plan(&self) -> &AftPlan {
+        &self.plan
+    }
+
+    pub fn model(&self) -> &NonlinearModel {
+        self.model
+    }
+
+    pub fn receptance(&self) -> &Receptance {
+        &self.receptance
+    }
+
+    pub fn force(&self) -> &[f64] {
+        &self.force
+    }
+
+    /// The linear (all elements removed from the balance, `G = 0`) solution at Ω and level:
+    /// for elements in the paper's form that never slip, this is the exact stuck response.
+    pub fn linear_solution(&mut self, omega: f64, level: f64) -> Vec<f64> {
+        let q = self.q;
+        let mut x = vec![0.0; self.dimension()];
+        self.receptance.evaluate(omega, &mut self.harmonic[0]);
+        for i in 0..q {
+            let u = self.harmonic[0].u_force[i] * level;
+            x[cos_index(1) * q + i] = u.re;
+            x[sin_index(1) * q + i] = -u.im;
+        }
+        x
+    }
+
+    /// Residual `R(x; Ω, λ_F)` and, if asked, `∂R/∂x`, `∂R/∂Ω`, `∂R/∂λ_F`.
+    pub fn evaluate(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        level: f64,
+        residual: &mut [f64],
+        jacobian: Option<Jacobians<'_>>,
+    ) -> Result<(), HbmError> {
+        self.evaluations += 1;
+        let q = self.q;
+        let nc = self.plan.n_coeffs();
+        let want = jacobian.is_some();
+        self.element_forces(x, omega, want)?;
+        for k in 1..=self.plan.n_harmonics() {
+            self.receptance.evaluate(k as f64 * omega, &mut self.harmonic[k - 1]);
+        }
+        // Harmonic 0: R_0 = x_0 + H(0) G_0.
+        for i in 0..q {
+            let mut r = x[i];
+            for j in 0..q {
+                r += self.h0[(i, j)] * self.g[j];
+            }
+            residual[i] = r;
+        }
+        for k in 1..=self.plan.n_harmonics() {
+            let hr = &self.harmonic[k - 1];
+            let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+            for i in 0..q {
+                let mut rc = x[ic + i];
+                let mut rs = x[is + i];
+                if k == 1 {
+                    rc -= level * hr.u_force[i].re;
+                    rs += level * hr.u_force[i].im;
+                }
+                for j in 0..q {
+                    let h = hr.h[(i, j)];
+                    rc += h.re * self.g[ic + j] + h.im * self.g[is + j];
+                    rs += -h.im * self.g[ic + j] + h.re * self.g[is + j];
+                }
+                residual[ic + i] = rc;
+                residual[is + i] = rs;
+            }
+        }
+        if let Some(jac) = jacobian {
+            self.jacobians(level, jac, nc);
+        }
+        Ok(())
+    }
+
+    fn jacobians(&mut self, level: f64, jac: Jacobians<'_>, nc: usize) {
+        let q = self.q;
+        let Jacobians { mut dx, domega, dlevel } = jac;
+        // ∂R/∂x = I + H_block ∂G/∂x.
+        for row in 0..q {
+            for col in 0..q * nc {
+                let mut v = 0.0;
+                for j in 0..q {
+                    v += self.h0[(row, j)] * self.dg[(j, col)];
+                }
+                dx[(row, col)] = v + if row == col { 1.0 } else { 0.0 };
+            }
+        }
+        for k in 1..=self.plan.n_harmonics() {
+            let hr = &self.harmonic[k - 1];
+            let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+            for i in 0..q {
+                for col in 0..q * nc {
+                    let mut vc = 0.0;
+                    let mut vs = 0.0;
+                    for j in 0..q {
+                        let h = hr.h[(i, j)];
+                        let (gc, gs) = (self.dg[(ic + j, col)], self.dg[(is + j, col)]);
+                        vc += h.re * gc + h.im * gs;
+                        vs += -h.im * gc + h.re * gs;
+                    }
+                    dx[(ic + i, col)] = vc + if ic + i == col { 1.0 } else { 0.0 };
+                    dx[(is + i, col)] = vs + if is + i == col { 1.0 } else { 0.0 };
+                }
+            }
+        }
+        // ∂R/∂Ω = −λ_F ∂u_F/∂Ω + ∂H/∂Ω G + H ∂G/∂Ω, with ∂H_k/∂Ω = k H'(kΩ).
+        if let Some(dw) = domega {
+            for i in 0..q {
+                dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.dg_domega[j]).sum();
+            }
+            for k in 1..=self.plan.n_harmonics() {
+                let hr = &self.harmonic[k - 1];
+                let kf = k as f64;
+                let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+                for i in 0..q {
+                    let mut vc = 0.0;
+                    let mut vs = 0.0;
+                    if k == 1 {
+                        vc -= level * hr.du_force[i].re;
+                        vs += level * hr.du_force[i].im;
+                    }
+                    for j in 0..q {
+                        let dh = hr.dh[(i, j)] * kf;
+                        let h = hr.h[(i, j)];
+                        let (gc, gs) = (self.g[ic + j], self.g[is + j]);
+                        let (dgc, dgs) = (self.dg_domega[ic + j], self.dg_domega[is + j]);
+                        vc += dh.re * gc + dh.im * gs + h.re * dgc + h.im * dgs;
+                        vs += -dh.im * gc + dh.re * gs - h.im * dgc + h.re * dgs;
+                    }
+                    dw[ic + i] = vc;
+                    dw[is + i] = vs;
+                }
+            }
+        }
+        if let Some(dl) = dlevel {
+            dl.iter_mut().for_each(|v| *v = 0.0);
+            let hr = &self.harmonic[0];
+            for i in 0..q {
+                dl[cos_index(1) * q + i] = -hr.u_force[i].re;
+                dl[sin_index(1) * q + i] = hr.u_force[i].im;
+            }
+        }
+    }
+
+    /// AFT of every element (Eq. 15): `G(x)` and, if `want`, `∂G/∂x`, `∂G/∂Ω`, assembled from
+    /// the elements' own blocks (block diagonal over elements).
+    fn element_forces(&mut self, x: &[f64], omega: f64, want: bool) -> Result<(), HbmError> {
+        let q = self.q;
+        let nc = self.plan.n_coeffs();
+        if want {
+            self.dg.fill(0.0);
+        }
+        for (e, site) in self.model.elements.iter().enumerate() {
+            let d = site.law.n_dirs();
+            let off = self.offsets[e];
+            for c in 0..nc {
+                for a in 0..d {
+                    self.elem_u[e][c * d + a] = x[c * q + off + a];
+                }
+            }
+            let jac = if want { Some((self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e][..])) } else { None };
+            self.afts[e].evaluate(site.law.as_ref(), &self.plan, omega, &self.elem_u[e], &mut self.elem_g[e], jac)?;
+            for c in 0..nc {
+                for a in 0..d {
+                    let row = c * q + off + a;
+                    self.g[row] = self.elem_g[e][c * d + a];
+                    if want {
+                        self.dg_domega[row] = self.elem_dgdw[e][c * d + a];
+                        for c2 in 0..nc {
+                            for b in 0..d {
+                                self.dg[(row, c2 * q + off + b)] = self.elem_jac[e][(c * d + a, c2 * d + b)];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The AFT state of element `e` after the last evaluation (time samples of u, v, g, slip).
+    pub fn element_aft(&self, e: usize) -> &ElementAft {
+        &self.afts[e]
+    }
+
+    /// Harmonics of the element forces after the last evaluation (coefficient-major, q wide).
+    pub fn element_force_harmonics(&self) -> &[f64] {
+        &self.g
+    }
+}
+
+/// The derivatives asked of [`CondensedHbm::evaluate`].
+pub struct Jacobians<'a> {
+    /// `∂R/∂x` (n × n).
+    pub dx: MatMut<'a, f64>,
+    /// `∂R/∂Ω`.
+    pub domega: Option<&'a mut [f64]>,
+    /// `∂R/∂λ_F`.
+    pub dlevel: Option<&'a mut [f64]>,
+}
+
+/// Complex amplitude `c − i s` of harmonic `k ≥ 1` of direction/DOF `i` in a coefficient-major
+/// vector of width `width`.
+pub fn complex_amplitude(x: &[f64], width: usize, k: usize, i: usize) -> c64 {
+    c64::new(x[cos_index(k) * width + i], -x[sin_index(k) * width + i])
+}

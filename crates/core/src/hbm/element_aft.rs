@@ -1,0 +1,448 @@
+//! AFT evaluation of one element over a period (paper Eq. 15) with its analytic Jacobian.
+//!
+//! `X → u(θ_j) → g(θ_j) → G`: the trial motion's coefficients are synthesised on the `n_t`
+//! samples, the element's incremental law is marched along them, and the force samples are
+//! projected back on the harmonics.
+//!
+//! **Hysteresis.** The force at θ = 0 depends on the past, so the law is marched over whole
+//! periods from the element's initial state (its documented stuck-mean convention) until the
+//! state at the end of a period equals the state at its start (the periodic regime; a Jenkins
+//! element that slips reaches it after one period, one that never slips is periodic from the
+//! start); only the last period is kept. At most [`MAX_PERIODS`] periods are marched; more means
+//! the law has no periodic regime for this motion, which is reported.
+//!
+//! **Jacobian.** By forward differentiation through the recursion: with `S_j = ∂state_j/∂X`,
+//!
+//! ```text
+//! ∂g_j/∂X = ∂g/∂u E_j + Ω ∂g/∂v E'_j + ∂g/∂s S_{j−1}
+//! S_j     = ∂s/∂u E_j + Ω ∂s/∂v E'_j + ∂s/∂s S_{j−1}
+//! ∂G/∂X   = P [∂g_j/∂X]_j
+//! ```
+//!
+//! with `E`, `E'`, `P` the synthesis, derivative-synthesis and projection matrices of the plan.
+//! For a Jenkins slider this is the DESIGN note's `k (E_j − E_s(j))` in stick and 0 in slip. One
+//! more column carries `∂/∂Ω` (velocity-dependent laws only).
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, Par};
+
+use super::fourier::{AftPlan, AftScratch};
+use crate::elements::{Element, Tangent};
+
+/// Periods marched at most before declaring that the law has no periodic regime.
+pub const MAX_PERIODS: usize = 50;
+
+/// Relative change of the state over one period below which the regime is periodic. A
+/// return-mapping law reproduces its state exactly (bit for bit, or to a few ulps), so this
+/// only absorbs round-off.
+const PERIODICITY_TOLERANCE: f64 = 1e-12;
+
+/// The element's response to a trial motion could not be evaluated.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum AftError {
+    #[error("element {kind}: no periodic regime after {periods} periods of the trial motion (state still changing by {change:.3e})")]
+    NotPeriodic { kind: &'static str, periods: usize, change: f64 },
+    #[error("element {kind}: force is not finite for the trial motion")]
+    NotFinite { kind: &'static str },
+}
+
+/// Buffers and results of the AFT of one element (allocated once per element and plan).
+pub struct ElementAft {
+    d: usize,
+    s: usize,
+    nc: usize,
+    nt: usize,
+    /// Displacement and velocity samples, `u[a * nt + j]`.
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
+    /// Force samples of the periodic regime, `g[a * nt + j]`.
+    pub g: Vec<f64>,
+    /// Whether the element slips at sample j of the periodic regime.
+    pub slipping: Vec<bool>,
+    /// Number of periods marched in the last evaluation.
+    pub periods: usize,
+    dudtheta: Vec<f64>,
+    state: Vec<f64>,
+    /// `∂state_0/∂u(θ_0)`, `s × d`.
+    ds0: Vec<f64>,
+    state_before: Vec<f64>,
+    state_period_start: Vec<f64>,
+    tangent: Tangent,
+    /// `S` (`s × (nc·d + 1)`) before and after an update.
+    sens: Mat<f64>,
+    sens_next: Mat<f64>,
+    /// `∂g_j/∂(X, Ω)` rows for each direction: `dgdx[a]` is `nt × (nc·d + 1)`.
+    dgdx: Vec<Mat<f64>>,
+    /// `P ∂g/∂X` for one direction, `nc × (nc·d + 1)`.
+    projected: Mat<f64>,
+    coeff_buf: Vec<f64>,
+    time_buf: Vec<f64>,
+    scratch: AftScratch,
+    u_now: Vec<f64>,
+    v_now: Vec<f64>,
+    g_now: Vec<f64>,
+}
+
+impl ElementAft {
+    pub fn new(law: &dyn Element, plan: &AftPlan) -> Self {
+        let (d, s, nc, nt) = (law.n_dirs(), law.n_state(), plan.n_coeffs(), plan.n_samples());
+        let cols = nc * d + 1;
+        ElementAft {
+            d,
+            s,
+            nc,
+            nt,
+            u: vec![0.0; d * nt],
+            v: vec![0.0; d * nt],
+            g: vec![0.0; d * nt],
+            slipping: vec![false; nt],
+            periods: 0,
+            dudtheta: vec![0.0; d * nt],
+            state: vec![0.0; s],
+            ds0: vec![0.0; s * d],
+            state_before: vec![0.0; s],
+            state_period_start: vec![0.0; s],
+            tangent: Tangent::new(d, s),
+            sens: Mat::zeros(s, cols),
+            sens_next: Mat::zeros(s, cols),
+            dgdx: (0..d).map(|_| Mat::zeros(nt, cols)).collect(),
+            projected: Mat::zeros(nc, cols),
+            coeff_buf: vec![0.0; nc],
+            time_buf: vec![0.0; nt],
+            scratch: plan.scratch(),
+            u_now: vec![0.0; d],
+            v_now: vec![0.0; d],
+            g_now: vec![0.0; d],
+        }
+    }
+
+    /// Force harmonics `g_coeffs` (coefficient-major, `c·d + a`) of the element for the motion
+    /// with coefficients `u_coeffs` (same layout) at fundamental frequency `omega`; with
+    /// `jacobian = Some((J, dg_domega))`, also `J = ∂G/∂X` (`nc·d × nc·d`) and `∂G/∂Ω`.
+    pub fn evaluate(
+        &mut self,
+        law: &dyn Element,
+        plan: &AftPlan,
+        omega: f64,
+        u_coeffs: &[f64],
+        g_coeffs: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), AftError> {
+        let (d, s, nc, nt) = (self.d, self.s, self.nc, self.nt);
+        debug_assert_eq!(u_coeffs.len(), nc * d);
+        // Samples of u and du/dθ per direction (Eq. 15, DFT⁻¹).
+        for a in 0..d {
+            for c in 0..nc {
+                self.coeff_buf[c] = u_coeffs[c * d + a];
+            }
+            plan.synthesize(&self.coeff_buf, &mut self.u[a * nt..(a + 1) * nt], &mut self.scratch);
+            plan.synthesize_derivative(&self.coeff_buf, &mut self.dudtheta[a * nt..(a + 1) * nt], &mut self.scratch);
+            for j in 0..nt {
+                self.v[a * nt + j] = omega * self.dudtheta[a * nt + j];
+            }
+        }
+        let want_jac = jacobian.is_some();
+        let e = plan.synthesis();
+        let de = plan.synthesis_derivative_matrix();
+        let velocity = law.depends_on_velocity();
+
+        // Initial state and its sensitivity to X through u(θ_0) = E_0 X.
+        self.load_sample(0);
+        law.initial_state(&self.u_now, &mut self.state, want_jac.then_some(&mut self.ds0[..]));
+        if want_jac {
+            self.sens.fill(0.0);
+            for m in 0..s {
+                for a in 0..d {
+                    let w = self.ds0[m * d + a];
+                    if w != 0.0 {
+                        for c in 0..nc {
+                            self.sens[(m, c * d + a)] += w * e[(0, c)];
+                        }
+                    }
+                }
+            }
+        }
+
+        // March whole periods until the state repeats; keep the last one.
+        let hysteretic = s > 0;
+        let mut period = 0;
+        loop {
+            period += 1;
+            self.state_period_start.copy_from_slice(&self.state);
+            for j in 0..nt {
+                self.load_sample(j);
+                self.state_before.copy_from_slice(&self.state);
+                if want_jac {
+                    self.tangent.clear();
+                }
+                law.update(
+                    &self.u_now,
+                    &self.v_now,
+                    &mut self.state,
+                    &mut self.g_now,
+                    if want_jac { Some(&mut self.tangent) } else { None },
+                );
+                for a in 0..d {
+                    self.g[a * nt + j] = self.g_now[a];
+                }
+                self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
+                if want_jac {
+                    self.differentiate_sample(j, omega, velocity, e, de);
+                }
+            }
+            if !hysteretic {
+                break;
+            }
+            let scale = self.state_period_start.iter().chain(&self.state).fold(0.0f64, |m, x| m.max(x.abs()));
+            let change = self.state_period_start.iter().zip(&self.state).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            if change <= PERIODICITY_TOLERANCE * scale.max(f64::MIN_POSITIVE) {
+                break;
+            }
+            if period >= MAX_PERIODS {
+                return Err(AftError::NotPeriodic { kind: law.kind(), periods: period, change });
+            }
+        }
+        self.periods = period;
+        if self.g.iter().any(|x| !x.is_finite()) {
+            return Err(AftError::NotFinite { kind: law.kind() });
+        }
+
+        // Project back (Eq. 15, DFT).
+        for a in 0..d {
+            self.time_buf.copy_from_slice(&self.g[a * nt..(a + 1) * nt]);
+            plan.analyze(&self.time_buf, &mut self.coeff_buf, &mut self.scratch);
+            for c in 0..nc {
+                g_coeffs[c * d + a] = self.coeff_buf[c];
+            }
+        }
+        if let Some((mut jac, dg_domega)) = jacobian {
+            let p = plan.projection();
+            for a in 0..d {
+                matmul(self.projected.as_mut(), Accum::Replace, p.as_ref(), self.dgdx[a].as_ref(), 1.0, Par::Seq);
+                for c in 0..nc {
+                    let row = c * d + a;
+                    for col in 0..nc * d {
+                        jac[(row, col)] = self.projected[(c, col)];
+                    }
+                    dg_domega[row] = self.projected[(c, nc * d)];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn load_sample(&mut self, j: usize) {
+        let nt = self.nt;
+        for a in 0..self.d {
+            self.u_now[a] = self.u[a * nt + j];
+            self.v_now[a] = self.v[a * nt + j];
+        }
+    }
+
+    /// Chain rule through one update (module docs): rows `∂g_j/∂(X, Ω)` and the next `S`.
+    fn differentiate_sample(&mut self, j: usize, omega: f64, velocity: bool, e: &Mat<f64>, de: &Mat<f64>) {
+        let (d, s, nc, nt) = (self.d, self.s, self.nc, self.nt);
+        let cols = nc * d + 1;
+        let t = &self.tangent;
+        // ∂g_a/∂(X, Ω).
+        for a in 0..d {
+            let row = &mut self.dgdx[a];
+            for col in 0..cols {
+                row[(j, col)] = 0.0;
+            }
+            for b in 0..d {
+                let gu = t.dg_du[a * d + b];
+                let gv = if velocity { t.dg_dv[a * d + b] } else { 0.0 };
+                if gu != 0.0 || gv != 0.0 {
+                    for c in 0..nc {
+                        row[(j, c * d + b)] += gu * e[(j, c)] + gv * omega * de[(j, c)];
+                    }
+                    // v = Ω du/dθ: ∂v/∂Ω = du/dθ.
+                    row[(j, nc * d)] += gv * self.dudtheta[b * nt + j];
+                }
+            }
+            for m in 0..s {
+                let gs = t.dg_ds[a * s + m];
+                if gs != 0.0 {
+                    for col in 0..cols {
+                        row[(j, col)] += gs * self.sens[(m, col)];
+                    }
+                }
+            }
+        }
+        if s == 0 {
+            return;
+        }
+        // S_j from S_{j−1}.
+        for m in 0..s {
+            for col in 0..cols {
+                self.sens_next[(m, col)] = 0.0;
+            }
+            for b in 0..d {
+                let su = t.ds_du[m * d + b];
+                let sv = if velocity { t.ds_dv[m * d + b] } else { 0.0 };
+                if su != 0.0 || sv != 0.0 {
+                    for c in 0..nc {
+                        self.sens_next[(m, c * d + b)] += su * e[(j, c)] + sv * omega * de[(j, c)];
+                    }
+                    self.sens_next[(m, nc * d)] += sv * self.dudtheta[b * nt + j];
+                }
+            }
+            for l in 0..s {
+                let ss = t.ds_ds[m * s + l];
+                if ss != 0.0 {
+                    for col in 0..cols {
+                        self.sens_next[(m, col)] += ss * self.sens[(l, col)];
+                    }
+                }
+            }
+        }
+        std::mem::swap(&mut self.sens, &mut self.sens_next);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elements::{CubicSpring, Iwan, Jenkins, RegularizedCoulomb};
+    use crate::hbm::fourier::{cos_index, sin_index};
+
+    /// Closed forms of /work/shared/reference/jenkins-closed-form.md for u = a cos θ.
+    fn jenkins_closed_form(k: f64, fc: f64, a: f64) -> (f64, f64, f64) {
+        let cos_star = 1.0 - 2.0 * fc / (k * a);
+        let th = cos_star.acos();
+        let a1 = a * k / std::f64::consts::PI * (th - th.sin() * th.cos());
+        let b1 = -4.0 * fc / std::f64::consts::PI * (1.0 - fc / (k * a));
+        let w = 4.0 * fc * (a - fc / k);
+        (a1, b1, w)
+    }
+
+    fn jenkins_aft(k: f64, fc: f64, a: f64, nt: usize) -> (f64, f64, f64, ElementAft) {
+        let law = Jenkins::new(k, fc).unwrap();
+        let plan = AftPlan::new(7, nt).unwrap();
+        let mut aft = ElementAft::new(&law, &plan);
+        let mut u = vec![0.0; plan.n_coeffs()];
+        u[cos_index(1)] = a;
+        let mut g = vec![0.0; plan.n_coeffs()];
+        aft.evaluate(&law, &plan, 1500.0, &u, &mut g, None).unwrap();
+        // Energy per cycle from the harmonics (exact for the truncated motion): π Σ k (s_k g_ck − c_k g_sk).
+        let w = std::f64::consts::PI * (0.0 - a * g[sin_index(1)]);
+        (g[cos_index(1)], g[sin_index(1)], w, aft)
+    }
+
+    #[test]
+    fn jenkins_first_harmonic_and_energy_match_the_closed_form() {
+        let (k, fc) = (8.11e6, 1000.0);
+        for &a in &[2.0e-4, 5.0e-4, 3.0e-3] {
+            let (a1, b1, w) = jenkins_closed_form(k, fc, a);
+            let (c1, s1, wa, aft) = jenkins_aft(k, fc, a, 300);
+            // The AFT's stick/slip switch falls between samples: first-order error in 1/n_t,
+            // measured ≈ 1e-4 at 300 samples; the issue asks for 1e-3.
+            assert!(((c1 - a1) / a1).abs() < 1e-3, "a1 {c1} vs {a1}");
+            assert!(((s1 - b1) / b1).abs() < 1e-3, "b1 {s1} vs {b1}");
+            assert!(((wa - w) / w).abs() < 1e-3, "W {wa} vs {w}");
+            // Slipping: periodic after the first period of the march.
+            assert_eq!(aft.periods, 2);
+        }
+    }
+
+    #[test]
+    fn jenkins_aft_error_decreases_as_samples_grow() {
+        let (k, fc, a) = (8.11e6, 1000.0, 5.0e-4);
+        let (_, b1, _) = jenkins_closed_form(k, fc, a);
+        let errs: Vec<f64> =
+            [150, 300, 1200, 4800].iter().map(|&nt| ((jenkins_aft(k, fc, a, nt).1 - b1) / b1).abs()).collect();
+        // First order in 1/n_t: a 4x finer grid cuts the error by about 4 (allow 2.5 for the
+        // position of the switch relative to the grid, which varies with n_t).
+        assert!(errs[3] < errs[1] / 2.5 / 2.5, "{errs:?}");
+        assert!(errs[3] < 1e-5, "{errs:?}");
+    }
+
+    #[test]
+    fn stuck_jenkins_follows_the_spring_with_zero_mean_convention() {
+        let (k, fc) = (1e6, 1000.0);
+        let law = Jenkins::new(k, fc).unwrap();
+        let plan = AftPlan::new(3, 64).unwrap();
+        let mut aft = ElementAft::new(&law, &plan);
+        let mut u = vec![0.0; 7];
+        u[0] = 1e-4;
+        u[cos_index(1)] = 2e-4;
+        u[sin_index(2)] = 1e-4;
+        let mut g = vec![0.0; 7];
+        aft.evaluate(&law, &plan, 100.0, &u, &mut g, None).unwrap();
+        // |k u| ≤ 1e6 · 4e-4 = 400 N < 1000 N: stuck everywhere, f = k u exactly.
+        for c in 0..7 {
+            assert!((g[c] - k * u[c]).abs() < 1e-9 * k * 1e-4);
+        }
+        assert_eq!(aft.periods, 1);
+        assert!(aft.slipping.iter().all(|s| !s));
+    }
+
+    /// Central finite differences of the AFT, relative to the Jacobian's largest entry.
+    fn check_jacobian(law: &dyn Element, u: &[f64], omega: f64, tol: f64) {
+        let plan = AftPlan::new(5, 256).unwrap();
+        let nc = plan.n_coeffs();
+        let d = law.n_dirs();
+        let n = nc * d;
+        let mut aft = ElementAft::new(law, &plan);
+        let mut g = vec![0.0; n];
+        let mut jac = Mat::zeros(n, n);
+        let mut dgdw = vec![0.0; n];
+        aft.evaluate(law, &plan, omega, u, &mut g, Some((jac.as_mut(), &mut dgdw))).unwrap();
+        let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max(jac[(i, j)].abs()));
+        let umax = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let h = 1e-7 * umax;
+        let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+        let mut worst = 0.0f64;
+        for col in 0..n {
+            let mut up = u.to_vec();
+            up[col] += h;
+            aft.evaluate(law, &plan, omega, &up, &mut gp, None).unwrap();
+            let mut um = u.to_vec();
+            um[col] -= h;
+            aft.evaluate(law, &plan, omega, &um, &mut gm, None).unwrap();
+            for row in 0..n {
+                let fd = (gp[row] - gm[row]) / (2.0 * h);
+                worst = worst.max((fd - jac[(row, col)]).abs() / scale);
+            }
+        }
+        assert!(worst < tol, "{}: Jacobian vs finite differences {worst:.2e}", law.kind());
+        // ∂G/∂Ω.
+        let hw = 1e-6 * omega;
+        aft.evaluate(law, &plan, omega + hw, u, &mut gp, None).unwrap();
+        aft.evaluate(law, &plan, omega - hw, u, &mut gm, None).unwrap();
+        let gscale = g.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for row in 0..n {
+            let fd = (gp[row] - gm[row]) / (2.0 * hw);
+            assert!((fd - dgdw[row]).abs() * omega < tol * gscale, "{}: dG/dΩ row {row}", law.kind());
+        }
+    }
+
+    fn motion(amplitude: f64) -> Vec<f64> {
+        // A multi-harmonic motion with a mean: slip and stick phases at irregular places.
+        let mut u = vec![0.0; 11];
+        u[0] = 0.1 * amplitude;
+        u[cos_index(1)] = amplitude;
+        u[sin_index(1)] = 0.4 * amplitude;
+        u[cos_index(3)] = 0.15 * amplitude;
+        u[sin_index(2)] = -0.1 * amplitude;
+        u
+    }
+
+    #[test]
+    fn analytic_jacobians_equal_finite_differences() {
+        // Stick/slip switches move by O(h) under a perturbation, which FD sees as a kink of
+        // size O(h) in one sample: the FD error is O(h·k/n_t) relative, well below 1e-5.
+        let (k, fc) = (1e6, 100.0);
+        let jenkins = Jenkins::new(k, fc).unwrap();
+        check_jacobian(&jenkins, &motion(5e-5), 800.0, 1e-5); // stuck: k·|u| < 100 N
+        check_jacobian(&jenkins, &motion(2e-4), 800.0, 1e-5); // stick-slip
+        check_jacobian(&jenkins, &motion(1e-2), 800.0, 1e-5); // gross slip, short sticks
+        let paper = Jenkins::replacing_stiffness(k, fc).unwrap();
+        check_jacobian(&paper, &motion(2e-4), 800.0, 1e-5);
+        let iwan = Iwan::uniform(k, fc, 6).unwrap();
+        check_jacobian(&iwan, &motion(2e-4), 800.0, 1e-5);
+        check_jacobian(&RegularizedCoulomb::new(50.0, 1e-3).unwrap(), &motion(1e-5), 800.0, 1e-5);
+        check_jacobian(&CubicSpring::new(1e12).unwrap(), &motion(1e-4), 800.0, 1e-5);
+    }
+}

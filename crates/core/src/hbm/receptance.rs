@@ -1,0 +1,247 @@
+//! The linear part of the condensation (paper Eqs. 20-29): the dynamic flexibility of the
+//! linear model seen from the nonlinear directions, harmonic by harmonic.
+//!
+//! For harmonic k at fundamental Ω, with `ω = kΩ` and `Z(ω) = K − ω²M + iωD`:
+//!
+//! ```text
+//! H(ω) = Vᵀ Z(ω)⁻¹ V        (q × q, complex)      receptance on the q application directions
+//! u_F(ω) = Vᵀ Z(ω)⁻¹ F      (q)                    linear response to the excitation pattern
+//! ```
+//!
+//! `H⁻¹` is the Schur complement `A_qq − A_qp A_pp⁻¹ A_pq` of Eq. 28 written in the complex
+//! form of one harmonic block of Eq. 17, with the application vectors in place of the
+//! Gram-Schmidt basis of Eqs. 20-22 (same span, so the same condensed problem without
+//! building the n × n orthonormal basis).
+//!
+//! Two ways to evaluate it:
+//! - **Modal** (proportional or modal damping): with mass-normalised modes,
+//!   `Z⁻¹ = Σ_r φ_r φ_rᵀ / (ω_r² − ω² + iω c_r)`, exact when every mode is kept, and cheap:
+//!   O(q² m) per harmonic, whatever the model size.
+//! - **Direct** (a general damping matrix): one complex LU of `Z(ω)` per harmonic and frequency.
+//!
+//! Physical DOFs are recovered afterwards (Eq. 27) from the same representation.
+
+use faer::linalg::solvers::Solve;
+use faer::{c64, Mat};
+
+use crate::model::{Damping, LinearModel, ModelError, Modes};
+
+/// The linear dynamics of a model as seen from a few directions.
+#[derive(Debug)]
+pub enum Receptance {
+    Modal(ModalReceptance),
+    Direct(DirectReceptance),
+}
+
+#[derive(Debug)]
+pub struct ModalReceptance {
+    omega_r: Vec<f64>,
+    /// Modal damping coefficients `c_r` (modal equation `q̈ + c_r q̇ + ω_r² q`).
+    c_r: Vec<f64>,
+    /// `A = Vᵀ Φ` (q × m).
+    a: Mat<f64>,
+    /// `b = Φᵀ F` (m).
+    b: Vec<f64>,
+    /// `outer[(i q + j, r)] = A_ir A_jr`.
+    outer: Mat<f64>,
+    modes: Modes,
+}
+
+#[derive(Debug)]
+pub struct DirectReceptance {
+    mass: Mat<f64>,
+    stiffness: Mat<f64>,
+    damping: Mat<f64>,
+    /// `[V F]` (n × (q+1)).
+    rhs: Mat<c64>,
+}
+
+/// Complex receptance of one harmonic and its derivative with respect to ω.
+pub struct HarmonicReceptance {
+    /// `H` (q × q).
+    pub h: Mat<c64>,
+    pub dh: Mat<c64>,
+    /// `u_F` (q).
+    pub u_force: Vec<c64>,
+    pub du_force: Vec<c64>,
+}
+
+impl HarmonicReceptance {
+    pub fn new(q: usize) -> Self {
+        HarmonicReceptance {
+            h: Mat::zeros(q, q),
+            dh: Mat::zeros(q, q),
+            u_force: vec![c64::new(0.0, 0.0); q],
+            du_force: vec![c64::new(0.0, 0.0); q],
+        }
+    }
+}
+
+impl Receptance {
+    /// Prepare the receptance of `model` on the columns of `directions` (each of length n) for
+    /// the excitation pattern `force`.
+    pub fn new(model: &LinearModel, directions: &[&[f64]], force: &[f64]) -> Result<Self, ModelError> {
+        let n = model.n_dofs();
+        let q = directions.len();
+        if model.damping.is_modal() {
+            let modes = model.dense_modes()?;
+            let m = modes.omega.len();
+            let phi = &modes.shapes;
+            let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
+            let b = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
+            let outer = Mat::from_fn(q * q, m, |ij, r| a[(ij / q, r)] * a[(ij % q, r)]);
+            let c_r =
+                modes.omega.iter().enumerate().map(|(r, &w)| model.damping.modal_coefficient(r, w).unwrap()).collect();
+            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, outer, modes }))
+        } else {
+            // Check M > 0 and K > 0 the same way as the modal path, so both fail alike.
+            model.dense_modes()?;
+            let Damping::Matrix(d) = &model.damping else { unreachable!("non-modal damping is a matrix") };
+            let rhs = Mat::from_fn(n, q + 1, |l, j| c64::new(if j < q { directions[j][l] } else { force[l] }, 0.0));
+            Ok(Receptance::Direct(DirectReceptance {
+                mass: model.mass.to_dense(),
+                stiffness: model.stiffness.to_dense(),
+                damping: d.to_dense(),
+                rhs,
+            }))
+        }
+    }
+
+    /// Number of directions q.
+    pub fn n_directions(&self) -> usize {
+        match self {
+            Receptance::Modal(m) => m.a.nrows(),
+            Receptance::Direct(d) => d.rhs.ncols() - 1,
+        }
+    }
+
+    /// `H(ω)`, `u_F(ω)` and their ω-derivatives into `out`.
+    pub fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
+        match self {
+            Receptance::Modal(m) => m.evaluate(omega, out),
+            Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
+    /// Recovery (Eq. 27): complex amplitude at harmonic frequency `omega` along each of
+    /// `outputs` of `U = Z⁻¹ (level F − V G)`, with `G` the complex force amplitudes on the q
+    /// directions (`g_c − i g_s`). Also the viscous power term: returns
+    /// `(amplitudes, Uᴴ D U)` where `U` is the full response.
+    pub fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+        match self {
+            Receptance::Modal(m) => m.recover(omega, level, g, outputs),
+            Receptance::Direct(d) => d.recover(omega, level, g, outputs),
+        }
+    }
+}
+
+impl ModalReceptance {
+    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
+        let q = self.a.nrows();
+        let m = self.omega_r.len();
+        for i in 0..q {
+            out.u_force[i] = c64::new(0.0, 0.0);
+            out.du_force[i] = c64::new(0.0, 0.0);
+            for j in 0..q {
+                out.h[(i, j)] = c64::new(0.0, 0.0);
+                out.dh[(i, j)] = c64::new(0.0, 0.0);
+            }
+        }
+        for r in 0..m {
+            let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
+            let inv = den.inv();
+            // d(1/den)/dω = −(−2ω + i c_r)/den² = (2ω − i c_r)/den².
+            let dinv = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
+            for i in 0..q {
+                let ab = self.a[(i, r)] * self.b[r];
+                out.u_force[i] += inv * ab;
+                out.du_force[i] += dinv * ab;
+                for j in 0..q {
+                    let o = self.outer[(i * q + j, r)];
+                    out.h[(i, j)] += inv * o;
+                    out.dh[(i, j)] += dinv * o;
+                }
+            }
+        }
+    }
+
+    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+        let q = self.a.nrows();
+        let m = self.omega_r.len();
+        let phi = &self.modes.shapes;
+        let mut amps = vec![c64::new(0.0, 0.0); outputs.len()];
+        let mut dissipation = 0.0;
+        for r in 0..m {
+            let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
+            let mut load = c64::new(level * self.b[r], 0.0);
+            for i in 0..q {
+                load -= g[i] * self.a[(i, r)];
+            }
+            let coord = load / den;
+            // Modal viscous term: φ_rᵀ D φ_r = c_r (mass-normalised modes).
+            dissipation += self.c_r[r] * coord.norm_sqr();
+            for (amp, o) in amps.iter_mut().zip(outputs) {
+                let p: f64 = o.iter().enumerate().map(|(l, v)| v * phi[(l, r)]).sum();
+                *amp += coord * p;
+            }
+        }
+        (amps, dissipation)
+    }
+}
+
+impl DirectReceptance {
+    fn dynamic_stiffness(&self, omega: f64) -> Mat<c64> {
+        let n = self.mass.nrows();
+        Mat::from_fn(n, n, |i, j| {
+            c64::new(self.stiffness[(i, j)] - omega * omega * self.mass[(i, j)], omega * self.damping[(i, j)])
+        })
+    }
+
+    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
+        let n = self.mass.nrows();
+        let q = self.rhs.ncols() - 1;
+        let z = self.dynamic_stiffness(omega);
+        let y = z.partial_piv_lu().solve(&self.rhs);
+        // Z' = −2ωM + iD; by symmetry of Z, Vᵀ Z⁻¹ Z' Z⁻¹ W = Y_Vᵀ Z' Y_W.
+        let zp = Mat::from_fn(n, n, |i, j| c64::new(-2.0 * omega * self.mass[(i, j)], self.damping[(i, j)]));
+        let zpy = &zp * &y;
+        for i in 0..q {
+            for j in 0..=q {
+                let mut v = c64::new(0.0, 0.0);
+                let mut dv = c64::new(0.0, 0.0);
+                for l in 0..n {
+                    v += self.rhs[(l, i)] * y[(l, j)];
+                    dv -= y[(l, i)] * zpy[(l, j)];
+                }
+                if j < q {
+                    out.h[(i, j)] = v;
+                    out.dh[(i, j)] = dv;
+                } else {
+                    out.u_force[i] = v;
+                    out.du_force[i] = dv;
+                }
+            }
+        }
+    }
+
+    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+        let n = self.mass.nrows();
+        let q = self.rhs.ncols() - 1;
+        let load = Mat::from_fn(n, 1, |l, _| {
+            let mut v = self.rhs[(l, q)] * level;
+            for i in 0..q {
+                v -= self.rhs[(l, i)] * g[i];
+            }
+            v
+        });
+        let u = self.dynamic_stiffness(omega).partial_piv_lu().solve(&load);
+        let amps = outputs.iter().map(|o| (0..n).map(|l| u[(l, 0)] * o[l]).sum()).collect();
+        let mut dissipation = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                dissipation += self.damping[(i, j)] * (u[(i, 0)].conj() * u[(j, 0)]).re;
+            }
+        }
+        (amps, dissipation)
+    }
+}
