@@ -9,3 +9,4 @@
 pub mod elements;
 pub mod hbm;
 pub mod model;
+pub mod timesim;
