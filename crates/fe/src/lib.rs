@@ -3,3 +3,6 @@
 //! Meshes in ([`mesh`]), finite elements and sparse assembly ([`assembly`]), the sparse
 //! eigensolver ([`eigen`]) and the reductions ([`reduction`]: Craig-Bampton, the paper's
 //! free-mode variant Eqs. 3-5, slipped-joint enrichment).
+pub mod assembly;
+pub mod element;
+pub mod mesh;

@@ -1,0 +1,1 @@
+//! Gmsh `.msh` 4.1 meshes, ASCII and binary.

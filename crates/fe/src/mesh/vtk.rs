@@ -1,0 +1,1 @@
+//! Mode shapes to VTK legacy files.
