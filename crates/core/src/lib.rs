@@ -6,6 +6,7 @@
 //! Eqs. 13-29) → [`continuation`] (pseudo-arclength, Eqs. 31-32) → [`post`] (FRFs, harmonics,
 //! stick-slip velocity Eq. 33, energy). [`timesim`] integrates Eq. 12 in time as an independent
 //! check; [`signal`] turns time records into what the paper compares.
+pub mod continuation;
 pub mod elements;
 pub mod hbm;
 pub mod model;

@@ -1,0 +1,323 @@
+//! Pseudo-arclength continuation of `R(x, λ) = 0` (paper Section 4.3, Eqs. 31-32).
+//!
+//! Any problem with `n` unknowns `x` and one parameter `λ` (the excitation frequency Ω of a
+//! harmonic-balance sweep, a force level at fixed frequency, the amplitude of a backbone...)
+//! implements [`Problem`]; [`continue_branch`] follows its solution curve from `λ_start` to
+//! `λ_end` through turning points and returns a [`Branch`] of converged [`Point`]s and the
+//! [`TerminationReason`].
+//!
+//! # Scaled variables (Eq. 31)
+//!
+//! The arclength between consecutive points is (Eq. 31)
+//!
+//! ```text
+//! Δs² = ‖x_{i+1} − x_i‖² + α |λ_{i+1} − λ_i|²
+//! ```
+//!
+//! and α is chosen here, never by the user: the continuation works in the scaled variables
+//! `z = [x / s_x, λ / s_λ]`, so α = (s_x / s_λ)², with `s_λ = |λ_end − λ_start|` (a step of 1 in
+//! λ crosses the band) and `s_x` the largest of `‖x‖` at the first point, the change of `x` the
+//! first tangent predicts across the band (`‖dx/dλ‖ s_λ`, which sizes a sweep that starts from
+//! `x = 0`) and `‖x‖` of every point accepted since (a resonance peak rises far above its
+//! off-resonance start). A problem may fix `s_x` instead ([`Scales`]). Residuals are measured
+//! relative to a residual scale `s_R` (the problem's, or `‖R(0, λ_start)‖`: the forcing).
+//! Step sizes ([`Options`]) are scaled arclengths.
+//!
+//! # The loop
+//!
+//! The first point is a plain Newton solve at fixed `λ_start` from the caller's guess (e.g. the
+//! linear solution). Then, from the last converged point `z_i`:
+//!
+//! - **PREDICT**: `z_p = z_i + h t`, `t` the unit secant `z_i − z_{i−1}` ([`Predictor::Secant`],
+//!   default), the unit tangent, null vector of `[∂R/∂z]` ([`Predictor::Tangent`]), or the
+//!   paper's second-degree Lagrange polynomial through `z_{i−2}, z_{i−1}, z_i` parametrised by
+//!   their cumulative arclength (Eq. 31), evaluated at `s_i + h` ([`Predictor::Lagrange`]).
+//! - **CORRECT**: Newton on the bordered system (Eq. 32), the correction orthogonal to the
+//!   prediction direction `t = (z_p − z_i)/‖z_p − z_i‖`:
+//!
+//!   ```text
+//!   [ ∂R/∂z(z_k) ] Δz = − [ R(z_k)          ]      z_{k+1} = z_k + Δz
+//!   [ tᵀ         ]        [ tᵀ (z_k − z_p)  ]
+//!   ```
+//!
+//!   (Eq. 32 writes the last row as `2 (z_p − z_i)ᵀ`, the same hyperplane), until
+//!   `‖R‖ ≤ max(rtol s_R, atol)`.
+//! - **ACCEPT-REJECT**: a correction is rejected when Newton fails (no convergence within
+//!   `max_iterations`, a non-finite residual or a singular bordered matrix), when the corrector
+//!   travelled farther than the step itself (a jump to another part of the curve) or when the
+//!   secant turned by more than `max_angle` from the previous one (a fold taken too coarsely).
+//! - **ADAPT STEP**: a rejection halves `h` and retries from `z_i`; an acceptance after at most
+//!   `easy_iterations` Newton iterations multiplies `h` by `growth` (not right after a
+//!   rejection); `h` stays within `[min_step, max_step]`.
+//! - **TERMINATE**: the branch ends as a value ([`TerminationReason`]): when a point passes
+//!   `λ_end` (or, after a fold, goes back past `λ_start`) the last point is replaced by a Newton
+//!   solve at exactly that `λ` from the interpolated guess; when `max_points` are stored; when
+//!   `h` falls below `min_step`; when the problem returns an error. Every converged point before
+//!   is kept.
+//!
+//! Progress goes to an [`Observer`]; the library never prints. Each point carries its call
+//! counts ([`Calls`]).
+
+mod linear;
+mod run;
+
+pub use run::continue_branch;
+
+use faer::MatMut;
+
+/// `R(x, λ) = 0`, `x ∈ Rⁿ`, `λ` the continuation parameter (Ω, a force level, ...).
+pub trait Problem {
+    /// Number of unknowns `n` (and of residual equations).
+    fn dimension(&self) -> usize;
+
+    /// Write `R(x, λ)` into `residual` and, when `jacobian` is given, `∂R/∂x` (n×n, in a
+    /// column-major view) and `∂R/∂λ`. The Jacobian buffers are zeroed before the call, so only
+    /// non-zero entries need writing. An `Err` ends the continuation (it is reported with the
+    /// `λ` where it happened); a non-finite residual only rejects the current step.
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError>;
+
+    /// Typical magnitudes for scaling; the default derives them from the start point.
+    fn scales(&self) -> Scales {
+        Scales::default()
+    }
+}
+
+/// Typical magnitudes a problem may impose (positive and finite when given).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Scales {
+    /// Norm of a typical `x` (fixes `s_x`; default: automatic, see the module documentation).
+    pub unknowns: Option<f64>,
+    /// Norm of a typical residual term, e.g. the excitation force (default `‖R(0, λ_start)‖`).
+    pub residual: Option<f64>,
+}
+
+/// A failure of the problem itself (not a convergence failure), e.g. an invalid state.
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+#[error("{message}")]
+pub struct ProblemError {
+    pub message: String,
+}
+
+impl ProblemError {
+    pub fn new(message: impl Into<String>) -> Self {
+        ProblemError { message: message.into() }
+    }
+}
+
+/// How the next point is predicted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Predictor {
+    /// Along the chord through the last two points (tangent at the first step).
+    #[default]
+    Secant,
+    /// Along the null vector of the bordered Jacobian at the last point.
+    Tangent,
+    /// Second-degree Lagrange polynomial through the last three points, parametrised by
+    /// arclength (the paper's choice; secant while fewer than three points exist).
+    Lagrange,
+}
+
+/// Settings of the continuation. Steps are scaled arclengths (see the module documentation):
+/// a step of 1 crosses the whole λ interval when `x` does not change.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    pub predictor: Predictor,
+    pub initial_step: f64,
+    pub min_step: f64,
+    pub max_step: f64,
+    /// Step multiplier after an easy correction.
+    pub growth: f64,
+    /// A correction with at most this many Newton iterations is easy.
+    pub easy_iterations: usize,
+    /// Newton iterations allowed per correction.
+    pub max_iterations: usize,
+    /// Newton iterations allowed for a solve at fixed λ from the caller's guess.
+    pub first_point_max_iterations: usize,
+    /// Largest turn (radians) of the secant between consecutive steps.
+    pub max_angle: f64,
+    /// Relative residual tolerance, of the residual scale.
+    pub rtol: f64,
+    /// Absolute residual floor (residual units): the tolerance never goes below it.
+    pub atol: f64,
+    /// Number of points after which the branch stops.
+    pub max_points: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            predictor: Predictor::Secant,
+            initial_step: 1e-2,
+            min_step: 1e-7,
+            max_step: 5e-2,
+            growth: 1.5,
+            easy_iterations: 3,
+            max_iterations: 10,
+            first_point_max_iterations: 50,
+            max_angle: 0.5,
+            rtol: 1e-10,
+            atol: 1e-14,
+            max_points: 10_000,
+        }
+    }
+}
+
+/// Calls made to the problem for one point (its rejected attempts included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Calls {
+    /// Residual evaluations.
+    pub residuals: usize,
+    /// Jacobian evaluations.
+    pub jacobians: usize,
+    /// LU factorisations.
+    pub factorizations: usize,
+}
+
+impl std::ops::AddAssign for Calls {
+    fn add_assign(&mut self, other: Calls) {
+        self.residuals += other.residuals;
+        self.jacobians += other.jacobians;
+        self.factorizations += other.factorizations;
+    }
+}
+
+/// One converged solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Point {
+    pub x: Vec<f64>,
+    pub lambda: f64,
+    /// Newton iterations of the accepted correction.
+    pub iterations: usize,
+    /// `‖R(x, λ)‖` (Euclidean, residual units).
+    pub residual_norm: f64,
+    /// Scaled arclength step of the accepted prediction (0 for the first point; for a point
+    /// placed on an end of the interval, the scaled distance from the previous point).
+    pub step: f64,
+    /// Rejected attempts before this point was accepted.
+    pub rejected: usize,
+    pub calls: Calls,
+}
+
+/// Why a branch ended. None of these is an error: the points found are in the [`Branch`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum TerminationReason {
+    /// The last point is at `λ_end`.
+    ReachedEnd,
+    /// After a fold, the branch came back to `λ_start`; the last point is at `λ_start`.
+    ReturnedToStart,
+    /// `max_points` points are stored.
+    MaxPoints,
+    /// The solve at `λ_start` from the caller's guess did not converge.
+    FirstPointFailed { lambda: f64, residual_norm: f64, iterations: usize },
+    /// Every step down to `min_step` failed after the point at `lambda`.
+    StepTooSmall {
+        /// λ of the last converged point.
+        lambda: f64,
+        /// Residual norm at the end of the last failed correction.
+        residual_norm: f64,
+        /// Steps tried (each half the previous).
+        attempts: usize,
+        /// Newton iterations spent on them.
+        iterations: usize,
+    },
+    /// The problem returned an error when evaluated at `lambda`.
+    ProblemError {
+        lambda: f64,
+        /// λ of the last converged point, if any.
+        last_lambda: Option<f64>,
+        error: ProblemError,
+    },
+}
+
+/// A continued solution branch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Branch {
+    pub points: Vec<Point>,
+    pub termination: TerminationReason,
+    /// All calls, rejected attempts included.
+    pub calls: Calls,
+}
+
+/// Receives every converged point as it is accepted.
+pub trait Observer {
+    /// `fraction_done` in [0, 1]: the furthest λ reached, as a fraction of the interval.
+    fn on_point(&mut self, point: &Point, fraction_done: f64);
+}
+
+impl<F: FnMut(&Point, f64)> Observer for F {
+    fn on_point(&mut self, point: &Point, fraction_done: f64) {
+        self(point, fraction_done)
+    }
+}
+
+/// An observer that ignores everything.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Silent;
+
+impl Observer for Silent {
+    fn on_point(&mut self, _: &Point, _: f64) {}
+}
+
+/// Invalid input to the continuation (as opposed to a branch that ends early).
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum ContinuationError {
+    #[error("continuation option `{name}` is {value}, expected {expected}")]
+    InvalidOption { name: &'static str, value: f64, expected: &'static str },
+    #[error("the initial guess has {len} unknowns, expected {expected} (the problem's dimension)")]
+    WrongGuessLength { len: usize, expected: usize },
+    #[error("the continuation interval [{start}, {end}] is empty or not finite: give two different finite values")]
+    EmptyInterval { start: f64, end: f64 },
+    #[error("the problem's {name} scale is {value}, expected a positive finite value")]
+    InvalidScale { name: &'static str, value: f64 },
+}
+
+impl Options {
+    /// Check every option; the error names the first invalid one.
+    pub fn validate(&self) -> Result<(), ContinuationError> {
+        fn check(ok: bool, name: &'static str, value: f64, expected: &'static str) -> Result<(), ContinuationError> {
+            if ok {
+                Ok(())
+            } else {
+                Err(ContinuationError::InvalidOption { name, value, expected })
+            }
+        }
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        check(positive(self.min_step), "min_step", self.min_step, "a positive number")?;
+        check(
+            positive(self.max_step) && self.max_step >= self.min_step,
+            "max_step",
+            self.max_step,
+            "a positive number not below min_step",
+        )?;
+        check(
+            positive(self.initial_step) && self.initial_step >= self.min_step && self.initial_step <= self.max_step,
+            "initial_step",
+            self.initial_step,
+            "a number within [min_step, max_step]",
+        )?;
+        check(self.growth.is_finite() && self.growth >= 1.0, "growth", self.growth, "a number of at least 1")?;
+        check(self.max_iterations >= 1, "max_iterations", self.max_iterations as f64, "at least 1")?;
+        check(
+            self.first_point_max_iterations >= 1,
+            "first_point_max_iterations",
+            self.first_point_max_iterations as f64,
+            "at least 1",
+        )?;
+        check(
+            positive(self.max_angle) && self.max_angle <= std::f64::consts::PI,
+            "max_angle",
+            self.max_angle,
+            "an angle in (0, π] radians",
+        )?;
+        check(positive(self.rtol), "rtol", self.rtol, "a positive number")?;
+        check(self.atol.is_finite() && self.atol >= 0.0, "atol", self.atol, "a non-negative number")?;
+        check(self.max_points >= 1, "max_points", self.max_points as f64, "at least 1")?;
+        Ok(())
+    }
+}

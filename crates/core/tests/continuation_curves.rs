@@ -1,0 +1,253 @@
+//! Continuation on algebraic curves whose points are known exactly: a circle (one fold, back to
+//! the start on the other side), a cubic S-curve (two folds, both sweep directions), and
+//! problems that fail on purpose to check step halving and termination reasons.
+
+use faer::MatMut;
+use stickslip_core::continuation::{
+    continue_branch, Branch, Options, Point, Predictor, Problem, ProblemError, Silent, TerminationReason,
+};
+
+/// x² + λ² = 1.
+struct Circle;
+
+impl Problem for Circle {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        residual[0] = x[0] * x[0] + lambda * lambda - 1.0;
+        if let Some((mut jx, dl)) = jacobian {
+            jx[(0, 0)] = 2.0 * x[0];
+            dl[0] = 2.0 * lambda;
+        }
+        Ok(())
+    }
+}
+
+/// x³ − 3x − λ = 0: folds at x = ∓1, λ = ±2.
+struct SCurve;
+
+impl Problem for SCurve {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        residual[0] = x[0].powi(3) - 3.0 * x[0] - lambda;
+        if let Some((mut jx, dl)) = jacobian {
+            jx[(0, 0)] = 3.0 * x[0] * x[0] - 3.0;
+            dl[0] = -1.0;
+        }
+        Ok(())
+    }
+}
+
+/// The straight line x = λ, whose residual is NaN on chosen calls or in a chosen region, and
+/// which returns an error beyond `error_above`.
+struct Line {
+    calls: usize,
+    nan_on_call: Option<usize>,
+    nan_above: f64,
+    error_above: f64,
+}
+
+impl Line {
+    fn new() -> Self {
+        Line { calls: 0, nan_on_call: None, nan_above: f64::INFINITY, error_above: f64::INFINITY }
+    }
+}
+
+impl Problem for Line {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        self.calls += 1;
+        if lambda > self.error_above {
+            return Err(ProblemError::new(format!("no solution model beyond λ = {}", self.error_above)));
+        }
+        residual[0] =
+            if Some(self.calls) == self.nan_on_call || lambda > self.nan_above { f64::NAN } else { x[0] - lambda };
+        if let Some((mut jx, dl)) = jacobian {
+            jx[(0, 0)] = 1.0;
+            dl[0] = -1.0;
+        }
+        Ok(())
+    }
+}
+
+fn run<P: Problem>(problem: &mut P, guess: f64, start: f64, end: f64, options: &Options) -> Branch {
+    continue_branch(problem, &[guess], start, end, options, &mut Silent).expect("valid input")
+}
+
+/// Number of reversals of the direction of λ along the branch (one per fold passed).
+fn reversals(points: &[Point]) -> usize {
+    let steps: Vec<f64> = points.windows(2).map(|w| w[1].lambda - w[0].lambda).collect();
+    steps.windows(2).filter(|w| w[0] * w[1] < 0.0).count()
+}
+
+const PREDICTORS: [Predictor; 3] = [Predictor::Secant, Predictor::Tangent, Predictor::Lagrange];
+
+#[test]
+fn circle_passes_its_fold_and_stops_exactly_at_the_start_on_the_other_side() {
+    for predictor in PREDICTORS {
+        let options = Options { predictor, ..Options::default() };
+        let branch = run(&mut Circle, 0.9, 0.0, 1.5, &options);
+        assert_eq!(branch.termination, TerminationReason::ReturnedToStart, "{predictor:?}");
+        // Every point on the circle: the residual tolerance is 1e-10 of ‖R(0, 0)‖ = 1, and
+        // |x² + λ² − 1| is the distance to the unit circle to first order (times 2).
+        for p in &branch.points {
+            assert!((p.x[0].hypot(p.lambda) - 1.0).abs() < 1e-10, "{predictor:?}: {p:?}");
+        }
+        assert_eq!(reversals(&branch.points), 1, "{predictor:?}: one fold, at λ = 1");
+        let top = branch.points.iter().map(|p| p.lambda).fold(f64::MIN, f64::max);
+        // The fold is passed by steps of at most max_step = 0.05 in scaled arclength (s_λ = 1.5,
+        // s_x = 1): the largest λ seen is within the sagitta of one step, (0.05·1.5)²/2 < 3e-3.
+        assert!(top > 1.0 - 3e-3, "{predictor:?}: fold at λ = 1 reached, got {top}");
+        let last = branch.points.last().unwrap();
+        assert_eq!(last.lambda, 0.0);
+        assert!((last.x[0] + 1.0).abs() < 1e-10, "{predictor:?}: ends at (−1, 0), got {}", last.x[0]);
+        assert!(branch.points.iter().all(|p| p.lambda >= 0.0));
+    }
+}
+
+#[test]
+fn s_curve_passes_both_folds_in_both_directions_and_ends_exactly_at_the_end() {
+    for predictor in PREDICTORS {
+        let options = Options { predictor, ..Options::default() };
+        // Up: from the lower branch at λ = −5 (x ≈ −2.28) to the upper one at λ = 5.
+        let up = run(&mut SCurve, -2.0, -5.0, 5.0, &options);
+        // Down: the mirror sweep.
+        let down = run(&mut SCurve, 2.0, 5.0, -5.0, &options);
+        for (branch, end, x_sign) in [(&up, 5.0, 1.0), (&down, -5.0, -1.0)] {
+            assert_eq!(branch.termination, TerminationReason::ReachedEnd, "{predictor:?}");
+            assert_eq!(reversals(&branch.points), 2, "{predictor:?}: folds at λ = ±2");
+            // Residual tolerance 1e-10·‖R(0, λ_start)‖ = 5e-10; |∂R/∂x| ≥ 3(x² − 1) > 0 away
+            // from the folds, so the residual itself is the check.
+            for p in &branch.points {
+                let r = p.x[0].powi(3) - 3.0 * p.x[0] - p.lambda;
+                assert!(r.abs() <= 5e-10, "{predictor:?}: {p:?}");
+            }
+            let last = branch.points.last().unwrap();
+            assert_eq!(last.lambda, end, "{predictor:?}: stops exactly at the end");
+            assert!(last.x[0] * x_sign > 2.0, "{predictor:?}: on the far branch, x = {}", last.x[0]);
+            // Both fold values of x = ±1 are visited: the points span x ∈ (−2.3, 2.3).
+            let (lo, hi) = branch.points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.x[0]), b.max(p.x[0])));
+            assert!(lo < -2.2 && hi > 2.2, "{predictor:?}: x spans [{lo}, {hi}]");
+        }
+    }
+}
+
+#[test]
+fn a_failed_correction_halves_the_step_and_the_next_step_does_not_grow() {
+    // On a straight line the secant prediction is exact: every point converges with zero
+    // Newton iterations (one call) and the step grows by `growth` until `max_step`.
+    let options = Options { initial_step: 1e-3, ..Options::default() };
+    let mut line = Line::new();
+    line.nan_on_call = Some(8);
+    let branch = run(&mut line, 0.0, 0.0, 1.0, &options);
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    let k = branch.points.iter().position(|p| p.rejected > 0).expect("a rejected attempt");
+    assert_eq!(branch.points.iter().filter(|p| p.rejected > 0).count(), 1);
+    let (before, hit, after) = (&branch.points[k - 1], &branch.points[k], &branch.points[k + 1]);
+    assert_eq!(hit.rejected, 1);
+    // Planned step: the previous one grown by 1.5 (the first step uses initial_step).
+    let planned = if k == 1 { options.initial_step } else { before.step * options.growth };
+    assert_eq!(hit.step, planned / 2.0, "one halving");
+    assert_eq!(after.step, hit.step, "no growth right after a rejection");
+    assert_eq!(branch.points[k + 2].step, hit.step * options.growth, "growth resumes");
+    assert_eq!(hit.calls.residuals, 2, "the failed attempt and the accepted one");
+    for p in &branch.points {
+        assert!((p.x[0] - p.lambda).abs() <= 1e-14);
+    }
+}
+
+#[test]
+fn steps_halve_down_to_min_step_before_a_wall() {
+    // NaN residuals beyond λ = 0.5: every step that crosses it fails.
+    let options = Options { initial_step: 1e-2, min_step: 1e-6, ..Options::default() };
+    let mut line = Line::new();
+    line.nan_above = 0.5;
+    let branch = run(&mut line, 0.0, 0.0, 1.0, &options);
+    let last = branch.points.last().unwrap();
+    assert!(last.lambda <= 0.5);
+    let planned = if last.rejected == 0 { (last.step * options.growth).min(options.max_step) } else { last.step };
+    // Halvings until the step falls below min_step.
+    let mut expected_attempts = 0;
+    let mut h = planned;
+    while h >= options.min_step {
+        h *= 0.5;
+        expected_attempts += 1;
+    }
+    match branch.termination {
+        TerminationReason::StepTooSmall { lambda, attempts, residual_norm, .. } => {
+            assert_eq!(lambda, last.lambda);
+            assert_eq!(attempts, expected_attempts);
+            assert!(residual_norm.is_nan());
+        }
+        other => panic!("expected StepTooSmall, got {other:?}"),
+    }
+    // The wall is approached to within a step smaller than min_step·√2 ... plus the step
+    // just before the halvings started; the points found are all kept and exact.
+    assert!(branch.points.len() > 10);
+    assert!(branch.points.iter().all(|p| (p.x[0] - p.lambda).abs() <= 1e-14));
+}
+
+#[test]
+fn a_problem_error_ends_the_branch_with_where_it_happened_and_keeps_the_points() {
+    let mut line = Line::new();
+    line.error_above = 0.6;
+    let branch = run(&mut line, 0.0, 0.0, 1.0, &Options::default());
+    let last = branch.points.last().unwrap().lambda;
+    match &branch.termination {
+        TerminationReason::ProblemError { lambda, last_lambda, error } => {
+            assert!(*lambda > 0.6, "failed at λ = {lambda}");
+            assert_eq!(*last_lambda, Some(last));
+            assert!(error.message.contains("0.6"));
+        }
+        other => panic!("expected ProblemError, got {other:?}"),
+    }
+    assert!(last <= 0.6 && last > 0.5, "points up to the failure are kept, last at {last}");
+    assert!(branch.points.iter().all(|p| (p.x[0] - p.lambda).abs() <= 1e-14));
+}
+
+#[test]
+fn invalid_input_is_an_error_naming_what_is_wrong() {
+    let bad = Options { max_step: 1e-9, ..Options::default() };
+    let err = continue_branch(&mut Circle, &[1.0], 0.0, 1.0, &bad, &mut Silent).unwrap_err();
+    assert!(err.to_string().contains("max_step"), "{err}");
+    let err = continue_branch(&mut Circle, &[1.0, 2.0], 0.0, 1.0, &Options::default(), &mut Silent).unwrap_err();
+    assert!(err.to_string().contains("expected 1"), "{err}");
+    let err = continue_branch(&mut Circle, &[1.0], 0.3, 0.3, &Options::default(), &mut Silent).unwrap_err();
+    assert!(err.to_string().contains("empty"), "{err}");
+}
+
+#[test]
+fn observer_sees_every_point_with_monotone_progress() {
+    let mut seen = Vec::new();
+    let mut observer = |p: &Point, fraction: f64| seen.push((p.lambda, fraction));
+    let branch = continue_branch(&mut SCurve, &[-2.0], -5.0, 5.0, &Options::default(), &mut observer).unwrap();
+    assert_eq!(seen.len(), branch.points.len());
+    assert!(seen.windows(2).all(|w| w[1].1 >= w[0].1));
+    assert_eq!(seen.last().unwrap().1, 1.0);
+    let total: usize = branch.points.iter().map(|p| p.calls.residuals).sum();
+    // The residual-scale evaluation R(0, λ_start) belongs to the first point.
+    assert_eq!(total, branch.calls.residuals);
+}
