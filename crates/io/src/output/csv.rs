@@ -1,0 +1,185 @@
+//! CSV writers: `frf.csv` and the per-point time data.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use super::{LevelResult, OutputError, PointRecord};
+
+/// Column names of `frf.csv` for points shaped like `template` (units in every name).
+pub fn frf_columns(template: &PointRecord) -> Vec<String> {
+    let mut cols: Vec<String> =
+        ["level_N", "frequency_Hz", "newton_iterations", "residual_rel"].iter().map(|s| s.to_string()).collect();
+    for o in &template.outputs {
+        let n = &o.name;
+        cols.extend([format!("{n}_disp_frf_m_per_N"), format!("{n}_accel_frf_m_s2_per_N"), format!("{n}_peak_m")]);
+        for k in 0..o.harmonics.len() {
+            cols.extend([format!("{n}_h{k}_amp_m"), format!("{n}_h{k}_phase_rad")]);
+        }
+    }
+    for e in &template.elements {
+        cols.extend([format!("{}_energy_J", e.name), format!("{}_stick_fraction", e.name)]);
+    }
+    cols
+}
+
+/// The numbers of one row of `frf.csv`, in the order of [`frf_columns`].
+pub(crate) fn frf_row(level_n: f64, p: &PointRecord) -> Vec<f64> {
+    let mut row = vec![level_n, p.frequency_hz, p.iterations as f64, p.residual];
+    for o in &p.outputs {
+        row.extend([o.disp_frf, o.accel_frf, o.peak]);
+        for &(a, ph) in &o.harmonics {
+            row.extend([a, ph]);
+        }
+    }
+    for e in &p.elements {
+        row.extend([e.energy_j, e.stick_fraction]);
+    }
+    row
+}
+
+/// The first point of all levels (it fixes the columns), after checking that every point has
+/// the same outputs, elements and number of harmonics.
+pub(crate) fn template(levels: &[LevelResult]) -> Result<Option<&PointRecord>, OutputError> {
+    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(None) };
+    let shape = |p: &PointRecord| {
+        (
+            p.outputs.iter().map(|o| (o.name.clone(), o.harmonics.len())).collect::<Vec<_>>(),
+            p.elements.iter().map(|e| e.name.clone()).collect::<Vec<_>>(),
+        )
+    };
+    let expected = shape(first);
+    for l in levels {
+        for p in &l.points {
+            if shape(p) != expected {
+                return Err(OutputError::Inconsistent {
+                    level_n: l.level_n,
+                    frequency_hz: p.frequency_hz,
+                    message: format!(
+                        "outputs/harmonics {:?} and elements {:?} differ from the first point's {:?} and {:?}",
+                        shape(p).0,
+                        shape(p).1,
+                        expected.0,
+                        expected.1
+                    ),
+                });
+            }
+        }
+    }
+    Ok(Some(first))
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), OutputError> {
+    let io = |source| OutputError::Io { path: path.to_path_buf(), source };
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    f.write_all(text.as_bytes()).map_err(io)?;
+    f.flush().map_err(io)
+}
+
+fn push_row(out: &mut String, values: &[f64]) {
+    for (i, v) in values.iter().enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        // `{:e}` is the shortest representation that reads back to the same f64.
+        write!(out, "{v:e}").expect("writing to a String cannot fail");
+    }
+    out.push('\n');
+}
+
+/// Write `frf.csv`: a header with units, then one row per converged point of every level, in
+/// level order then branch order. Iteration counts are written as integers.
+pub fn write_frf_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputError> {
+    let mut text = String::new();
+    let Some(first) = template(levels)? else {
+        return write_file(path, &(frf_columns(&PointRecord::default()).join(",") + "\n"));
+    };
+    text.push_str(&frf_columns(first).join(","));
+    text.push('\n');
+    for l in levels {
+        for p in &l.points {
+            let row = frf_row(l.level_n, p);
+            write!(text, "{:e},{:e},{},{:e},", row[0], row[1], p.iterations, row[3]).expect("String write");
+            if row.len() > 4 {
+                push_row(&mut text, &row[4..]);
+            } else {
+                text.pop();
+                text.push('\n');
+            }
+        }
+    }
+    write_file(path, &text)
+}
+
+/// Write the time data of one point: `theta_rad`, `time_s`, then per output `<out>_disp_m`,
+/// `<out>_vel_m_s`, per element `<el>_u_m`, `<el>_force_N`, `<el>_slider_vel_m_s`; one row
+/// per sample `θ_j = 2π j / n_t`. Series that were not kept are left out.
+pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> {
+    let n_t =
+        p.outputs.iter().map(|o| o.disp.len()).chain(p.elements.iter().map(|e| e.loop_u.len())).max().unwrap_or(0);
+    let mut names = vec!["theta_rad".to_string(), "time_s".to_string()];
+    let mut series: Vec<&[f64]> = Vec::new();
+    let mut add = |name: String, s: &'static str, v: &[f64]| -> Result<(), OutputError> {
+        if v.is_empty() {
+            return Ok(());
+        }
+        if v.len() != n_t {
+            return Err(OutputError::Inconsistent {
+                level_n: f64::NAN,
+                frequency_hz: p.frequency_hz,
+                message: format!("time series {name}{s} has {} samples, expected {n_t}", v.len()),
+            });
+        }
+        names.push(format!("{name}{s}"));
+        Ok(())
+    };
+    for o in &p.outputs {
+        add(o.name.clone(), "_disp_m", &o.disp)?;
+        add(o.name.clone(), "_vel_m_s", &o.vel)?;
+    }
+    for e in &p.elements {
+        add(e.name.clone(), "_u_m", &e.loop_u)?;
+        add(e.name.clone(), "_force_N", &e.loop_force)?;
+        add(e.name.clone(), "_slider_vel_m_s", &e.slider_velocity)?;
+    }
+    for o in &p.outputs {
+        series.extend([o.disp.as_slice(), o.vel.as_slice()].into_iter().filter(|s| !s.is_empty()));
+    }
+    for e in &p.elements {
+        series.extend(
+            [e.loop_u.as_slice(), e.loop_force.as_slice(), e.slider_velocity.as_slice()]
+                .into_iter()
+                .filter(|s| !s.is_empty()),
+        );
+    }
+    let mut text = names.join(",");
+    text.push('\n');
+    let omega = 2.0 * std::f64::consts::PI * p.frequency_hz;
+    let mut row = Vec::with_capacity(series.len() + 2);
+    for j in 0..n_t {
+        let theta = 2.0 * std::f64::consts::PI * j as f64 / n_t as f64;
+        row.clear();
+        row.extend([theta, theta / omega]);
+        row.extend(series.iter().map(|s| s[j]));
+        push_row(&mut text, &row);
+    }
+    write_file(path, &text)
+}
+
+/// Write `dir/points/level<i>_point<j>.csv` (i, j from 0, in level and branch order) for every
+/// point that carries time data. Returns the number of files written.
+pub fn write_time_data(dir: &Path, levels: &[LevelResult]) -> Result<usize, OutputError> {
+    let points_dir = dir.join("points");
+    let mut written = 0;
+    for (i, l) in levels.iter().enumerate() {
+        for (j, p) in l.points.iter().enumerate().filter(|(_, p)| p.has_time_data()) {
+            if written == 0 {
+                std::fs::create_dir_all(&points_dir)
+                    .map_err(|source| OutputError::Io { path: points_dir.clone(), source })?;
+            }
+            write_point_csv(&points_dir.join(format!("level{i}_point{j}.csv")), p)?;
+            written += 1;
+        }
+    }
+    Ok(written)
+}

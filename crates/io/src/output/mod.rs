@@ -1,0 +1,108 @@
+//! Result files of a frequency sweep: the FRF table `frf.csv` (one row per converged point, all
+//! levels), the per-point time data `points/level<i>_point<j>.csv`, and `frf.npz` (the same
+//! columns as NumPy arrays).
+//!
+//! The solver converts its branches into the plain records below ([`LevelResult`],
+//! [`PointRecord`], ...); the writers only format them. Numbers are written in Rust's shortest
+//! round-trip exponent form (`{:e}`), so reading a file back gives the same `f64` bit for bit.
+
+mod csv;
+mod npz;
+
+use std::path::PathBuf;
+
+pub use csv::{frf_columns, write_frf_csv, write_point_csv, write_time_data};
+pub use npz::write_frf_npz;
+
+/// All converged points of one force level.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LevelResult {
+    /// Excitation level (N).
+    pub level_n: f64,
+    pub points: Vec<PointRecord>,
+}
+
+/// One converged point of a branch.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointRecord {
+    /// Excitation frequency Ω / 2π (Hz).
+    pub frequency_hz: f64,
+    /// Newton iterations of the corrector.
+    pub iterations: usize,
+    /// Final residual norm relative to the excitation norm.
+    pub residual: f64,
+    pub outputs: Vec<OutputRecord>,
+    pub elements: Vec<ElementRecord>,
+}
+
+/// Response of one output at one point.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OutputRecord {
+    pub name: String,
+    /// |X₁| / F: amplitude of the first harmonic over the force level (m/N).
+    pub disp_frf: f64,
+    /// Ω² |X₁| / F (m s⁻² / N).
+    pub accel_frf: f64,
+    /// max |x(t)| over the period (m).
+    pub peak: f64,
+    /// `(A_k, φ_k)` for k = 0..=N with `x(t) = A_0 + Σ A_k cos(kΩt + φ_k)`: amplitude (m) and
+    /// phase (rad); `A_0` is the mean (signed) and `φ_0 = 0`. See [`harmonics_from_coefficients`].
+    pub harmonics: Vec<(f64, f64)>,
+    /// Displacement over one period at `θ_j = 2π j / n_t` (m); empty when not kept.
+    pub disp: Vec<f64>,
+    /// Velocity over one period (m/s); empty when not kept.
+    pub vel: Vec<f64>,
+}
+
+/// State of one element at one point.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ElementRecord {
+    pub name: String,
+    /// Energy dissipated per cycle ∮ g du (J).
+    pub energy_j: f64,
+    /// Fraction of the period spent stuck (0..1).
+    pub stick_fraction: f64,
+    /// Element displacement `u = Vᵀ U` over one period (m); empty when not kept.
+    pub loop_u: Vec<f64>,
+    /// Element force over one period (N), the hysteresis loop against `loop_u`.
+    pub loop_force: Vec<f64>,
+    /// Slider velocity v_P over one period (m/s, paper Eq. 33).
+    pub slider_velocity: Vec<f64>,
+}
+
+impl PointRecord {
+    /// Does this point carry time data?
+    pub fn has_time_data(&self) -> bool {
+        self.outputs.iter().any(|o| !o.disp.is_empty()) || self.elements.iter().any(|e| !e.loop_u.is_empty())
+    }
+}
+
+/// `(amplitude, phase)` pairs, k = 0..=N, from Fourier coefficients `[c0, c1, s1, ..., cN, sN]`
+/// (the convention of `stickslip_core::hbm::fourier`): `c_k cos kθ + s_k sin kθ = A_k cos(kθ + φ_k)`
+/// with `A_k = √(c_k² + s_k²)` and `φ_k = atan2(−s_k, c_k)`.
+pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
+    assert!(coefficients.len() % 2 == 1, "expected 2N+1 coefficients, got {}", coefficients.len());
+    let n = coefficients.len() / 2;
+    std::iter::once((coefficients[0], 0.0))
+        .chain((1..=n).map(|k| {
+            let (c, s) = (coefficients[2 * k - 1], coefficients[2 * k]);
+            (c.hypot(s), (-s).atan2(c))
+        }))
+        .collect()
+}
+
+/// What went wrong writing results.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Points of one file must share outputs, elements and the number of harmonics.
+    #[error("level {level_n} N, point at {frequency_hz} Hz: {message}")]
+    Inconsistent { level_n: f64, frequency_hz: f64, message: String },
+    #[error("{0}")]
+    Plot(String),
+}

@@ -1,0 +1,1 @@
+//! Plots of results (plotters): FRFs of all levels, harmonics, hysteresis loops.

@@ -1,0 +1,233 @@
+//! From a validated [`Study`] to the objects the solver works on: the [`NonlinearModel`] of
+//! paper Eq. 12, the [`Excitation`] and the [`OutputSpec`]s.
+
+use std::path::Path;
+
+use faer::Side;
+use stickslip_core::elements::{CubicSpring, Element, Iwan, Jenkins, RegularizedCoulomb};
+use stickslip_core::model::{
+    relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, ModelError, NamedVector,
+    NonlinearModel,
+};
+
+use super::*;
+
+/// The harmonic force `levels_n[i] · pattern · cos(Ωt)` (paper Eq. 12), one run per level.
+#[derive(Clone, Debug)]
+pub struct Excitation {
+    /// Name of the load.
+    pub load: String,
+    /// Force pattern over the model's DOFs, in N per unit level (scale included).
+    pub pattern: Vec<f64>,
+    /// Force levels (N).
+    pub levels_n: Vec<f64>,
+}
+
+/// A reported output: the displacement `vectorᵀ U` (m), named by the user.
+#[derive(Clone, Debug)]
+pub struct OutputSpec {
+    pub name: String,
+    pub vector: Vec<f64>,
+}
+
+/// Largest model for which outputs default to every DOF when no `[[output]]` is given.
+const MAX_DEFAULT_OUTPUTS: usize = 20;
+
+impl Study {
+    /// Read the matrix files (if any), check the model (sizes, symmetry, M positive definite by
+    /// a Cholesky factorisation) and build the nonlinear model, the excitation and the outputs.
+    pub fn build_model(&self) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
+        let err = |at: Location, kind: StudyErrorKind| StudyError {
+            file: self.path.clone(),
+            location: Some(at),
+            kind: Box::new(kind),
+        };
+        let (mass, stiffness, dofs, model_at) = match &self.model {
+            ModelSpec::Inline { dofs, mass, stiffness, at } => (
+                Matrix::Dense(mass.clone()),
+                Matrix::Dense(stiffness.clone()),
+                dofs.iter().map(|d| dof_label(d)).collect::<Vec<_>>(),
+                *at,
+            ),
+            ModelSpec::Files { mass, stiffness, dofs, at } => {
+                let m = read_matrix(mass, "[model] mass_file").map_err(|k| err(*at, k))?;
+                let k = read_matrix(stiffness, "[model] stiffness_file").map_err(|k| err(*at, k))?;
+                let labels = match dofs {
+                    DofNames::Numbered => (1..=m.nrows()).map(|i| DofLabel::named(i.to_string())).collect(),
+                    DofNames::Inline(names) => names.iter().map(|d| dof_label(d)).collect(),
+                    DofNames::File(path) => read_dof_file(path).map_err(|k| err(*at, k))?,
+                };
+                (m, k, labels, *at)
+            }
+        };
+        let damping = match &self.damping {
+            DampingSpec::None => Damping::None,
+            DampingSpec::Rayleigh { alpha, beta } => Damping::Rayleigh { alpha: *alpha, beta: *beta },
+            DampingSpec::Modal { ratios } => Damping::Modal { ratios: ratios.clone() },
+            DampingSpec::Matrix(d) => Damping::Matrix(Matrix::Dense(d.clone())),
+            DampingSpec::File(path) => {
+                Damping::Matrix(read_matrix(path, "[model] damping_file").map_err(|k| err(model_at, k))?)
+            }
+        };
+        let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
+        let mut linear =
+            LinearModel::new(mass, stiffness, damping, dofs, Vec::new()).map_err(|e| err(model_at, model_error(e)))?;
+        check_mass_positive_definite(&linear.mass).map_err(|e| err(model_at, model_error(e)))?;
+
+        for l in &self.loads {
+            let ctx = format!("[[load]] {:?}", l.name);
+            let v = vector(&linear, &l.placement, &ctx).map_err(|k| err(l.at, k))?;
+            linear.loads.push(NamedVector { name: l.name.clone(), values: v.iter().map(|x| x * l.scale).collect() });
+        }
+
+        let mut sites = Vec::with_capacity(self.joints.len());
+        for j in &self.joints {
+            sites.push(self.joint_site(&linear, j).map_err(|k| err(j.at, k))?);
+        }
+
+        let load_name = match &self.excitation.load {
+            Some(name) => name.clone(),
+            None => self.loads[0].name.clone(),
+        };
+        let pattern = linear.load(&load_name).map_err(|e| err(self.excitation.at, model_error(e)))?.values.clone();
+        let excitation = Excitation { load: load_name, pattern, levels_n: self.excitation.levels.clone() };
+
+        let outputs = if self.outputs.is_empty() {
+            if linear.n_dofs() > MAX_DEFAULT_OUTPUTS {
+                return Err(StudyError {
+                    file: self.path.clone(),
+                    location: None,
+                    kind: Box::new(StudyErrorKind::Invalid(format!(
+                        "[[output]]: the model has {} DOFs; say which to report with [[output]] sections (every DOF is reported by default only up to {MAX_DEFAULT_OUTPUTS})",
+                        linear.n_dofs()
+                    ))),
+                });
+            }
+            (0..linear.n_dofs())
+                .map(|i| OutputSpec {
+                    name: sanitized(&linear.dofs[i].name),
+                    vector: relative_direction(linear.n_dofs(), i, None),
+                })
+                .collect()
+        } else {
+            let mut outs = Vec::with_capacity(self.outputs.len());
+            for o in &self.outputs {
+                let ctx = format!("[[output]] {:?}", o.name);
+                let v = vector(&linear, &o.placement, &ctx).map_err(|k| err(o.at, k))?;
+                outs.push(OutputSpec { name: o.name.clone(), vector: v });
+            }
+            outs
+        };
+
+        let model = NonlinearModel::new(linear, sites).map_err(|e| err(model_at, model_error(e)))?;
+        Ok((model, excitation, outputs))
+    }
+
+    /// The element of one joint on its application vector.
+    fn joint_site(&self, linear: &LinearModel, j: &JointSpec) -> Result<ElementSite, StudyErrorKind> {
+        let ctx = format!("[[joint]] {:?}", j.name);
+        let mut v = vector(linear, &j.placement, &ctx)?;
+        if let Placement::Vector(_) = j.placement {
+            // The paper normalises the application vector (Section 3.4): the threshold is then a
+            // force along a unit direction.
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm == 0.0 {
+                return Err(StudyErrorKind::Invalid(format!("{ctx}: vector is zero")));
+            }
+            v.iter_mut().for_each(|x| *x /= norm);
+        }
+        let element_error = |source| StudyErrorKind::Element { context: ctx.clone(), source };
+        // Paper Eq. 7: the stuck stiffness seen along V; it must be positive to be replaced.
+        let stuck = |s: JointStiffness| -> Result<(f64, bool), StudyErrorKind> {
+            match s {
+                JointStiffness::Own(k) => Ok((k, false)),
+                JointStiffness::Replaces(k) => Ok((k, true)),
+                JointStiffness::ReplacesComputed => {
+                    let k = stiffness_along(linear, &v);
+                    if k > 0.0 {
+                        Ok((k, true))
+                    } else {
+                        Err(StudyErrorKind::Invalid(format!(
+                            "{ctx}: the stiffness VᵀKV along the joint is {k:e} N/m; give the joint's own `stiffness` (N/m)"
+                        )))
+                    }
+                }
+            }
+        };
+        let law: Box<dyn Element> = match &j.law {
+            LawSpec::Jenkins { threshold, stiffness } => {
+                let (k, replaces) = stuck(*stiffness)?;
+                let law =
+                    if replaces { Jenkins::replacing_stiffness(k, *threshold) } else { Jenkins::new(k, *threshold) };
+                Box::new(law.map_err(element_error)?)
+            }
+            LawSpec::Iwan { stiffness, slip_force, sliders } => {
+                let (k, replaces) = stuck(*stiffness)?;
+                let law = Iwan::uniform(k, *slip_force, *sliders).map_err(element_error)?;
+                Box::new(if replaces { law.replacing_stiffness() } else { law })
+            }
+            LawSpec::Coulomb { threshold, velocity_scale } => {
+                Box::new(RegularizedCoulomb::new(*threshold, *velocity_scale).map_err(element_error)?)
+            }
+            LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
+        };
+        Ok(ElementSite { name: j.name.clone(), law, directions: vec![v] })
+    }
+}
+
+/// The vector over the model's DOFs that a placement stands for.
+fn vector(linear: &LinearModel, p: &Placement, ctx: &str) -> Result<Vec<f64>, StudyErrorKind> {
+    let n = linear.n_dofs();
+    let index = |name: &str| {
+        linear.dof_index(name).map_err(|source| StudyErrorKind::Model { context: ctx.to_string(), source })
+    };
+    match p {
+        Placement::Dof(a) => Ok(relative_direction(n, index(a)?, None)),
+        Placement::Between(a, b) => Ok(relative_direction(n, index(a)?, Some(index(b)?))),
+        Placement::Vector(v) if v.len() != n => Err(StudyErrorKind::Invalid(format!(
+            "{ctx}: vector has {} values, expected {n} (one per DOF of the model)",
+            v.len()
+        ))),
+        Placement::Vector(v) => Ok(v.clone()),
+    }
+}
+
+/// `node.direction` names (as in CalculiX `.dof` files) become nodal labels.
+fn dof_label(name: &str) -> DofLabel {
+    if let Some((node, dir)) = name.split_once('.') {
+        if let (Ok(node), Ok(dir)) = (node.parse::<u64>(), dir.parse::<u8>()) {
+            if (1..=6).contains(&dir) {
+                return DofLabel::nodal(node, dir);
+            }
+        }
+    }
+    DofLabel::named(name)
+}
+
+/// An output name derived from a DOF name (result columns allow ASCII letters, digits, `_`, `-`).
+fn sanitized(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
+}
+
+fn read_dof_file(path: &Path) -> Result<Vec<DofLabel>, StudyErrorKind> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| StudyErrorKind::Invalid(format!("[model] dof_file: cannot read {}: {e}", path.display())))?;
+    Ok(text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')).map(dof_label).collect())
+}
+
+fn read_matrix(path: &Path, context: &str) -> Result<Matrix, StudyErrorKind> {
+    crate::matrix::mtx::read(path).map_err(|source| StudyErrorKind::MatrixFile { context: context.into(), source })
+}
+
+/// M must be positive definite (every DOF has mass): a Cholesky factorisation succeeds.
+fn check_mass_positive_definite(mass: &Matrix) -> Result<(), ModelError> {
+    let ok = match mass {
+        Matrix::Dense(m) => m.llt(Side::Lower).is_ok(),
+        Matrix::Sparse(m) => m.sp_cholesky(Side::Lower).is_ok(),
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(ModelError::MassNotPositiveDefinite)
+    }
+}

@@ -1,0 +1,138 @@
+//! The study file as written: one serde struct per TOML section, every value wrapped in
+//! [`Spanned`] so that validation errors can point at the line and column of the offending key.
+//! Unknown keys are rejected everywhere (`deny_unknown_fields`): a misspelt option must never be
+//! silently ignored.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+pub(crate) type S<T> = Spanned<T>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawStudy {
+    pub model: S<RawModel>,
+    pub damping: Option<S<RawDamping>>,
+    #[serde(default)]
+    pub load: Vec<S<RawLoad>>,
+    #[serde(default)]
+    pub joint: Vec<S<RawJoint>>,
+    pub excitation: S<RawExcitation>,
+    pub sweep: S<RawSweep>,
+    pub harmonic_balance: Option<S<RawHarmonicBalance>>,
+    pub continuation: Option<S<RawContinuation>>,
+    #[serde(default)]
+    pub output: Vec<S<RawOutput>>,
+    pub output_options: Option<S<RawOutputOptions>>,
+}
+
+/// A matrix written inline: a list of rows, or a list of diagonal values.
+#[derive(Deserialize, Clone)]
+#[serde(untagged)]
+pub(crate) enum RawMatrix {
+    Rows(Vec<Vec<f64>>),
+    Diagonal(Vec<f64>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawModel {
+    pub dofs: Option<S<Vec<String>>>,
+    pub mass: Option<S<RawMatrix>>,
+    pub stiffness: Option<S<RawMatrix>>,
+    pub mass_file: Option<S<String>>,
+    pub stiffness_file: Option<S<String>>,
+    pub damping_file: Option<S<String>>,
+    pub dof_file: Option<S<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDamping {
+    pub alpha: Option<S<f64>>,
+    pub beta: Option<S<f64>>,
+    pub modal_ratios: Option<S<Vec<f64>>>,
+    pub matrix: Option<S<RawMatrix>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawLoad {
+    pub name: S<String>,
+    pub dof: Option<S<String>>,
+    pub scale: Option<S<f64>>,
+    pub values: Option<S<Vec<f64>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawJoint {
+    pub name: S<String>,
+    pub law: S<String>,
+    pub between: Option<S<Vec<String>>>,
+    pub dof: Option<S<String>>,
+    pub vector: Option<S<Vec<f64>>>,
+    pub threshold: Option<S<f64>>,
+    pub stiffness: Option<S<f64>>,
+    pub replaces_stiffness: Option<S<bool>>,
+    pub slip_force: Option<S<f64>>,
+    pub sliders: Option<S<i64>>,
+    pub velocity_scale: Option<S<f64>>,
+    pub k3: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawExcitation {
+    pub load: Option<S<String>>,
+    pub levels: S<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSweep {
+    pub start_hz: S<f64>,
+    pub end_hz: S<f64>,
+    pub step_hz: Option<S<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawHarmonicBalance {
+    pub harmonics: Option<S<i64>>,
+    pub samples: Option<S<i64>>,
+    pub tolerance: Option<S<f64>>,
+    pub max_iterations: Option<S<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawContinuation {
+    pub predictor: Option<S<String>>,
+    pub min_step_hz: Option<S<f64>>,
+    pub max_step_hz: Option<S<f64>>,
+    pub max_points: Option<S<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawOutput {
+    pub name: S<String>,
+    pub dof: Option<S<String>>,
+    pub vector: Option<S<Vec<f64>>>,
+}
+
+/// `time_data = "none" | "all"` or an integer k (every k-th point).
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(crate) enum RawTimeData {
+    Every(i64),
+    Word(String),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawOutputOptions {
+    pub time_data: Option<S<RawTimeData>>,
+    pub plot_format: Option<S<String>>,
+}

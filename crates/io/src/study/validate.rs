@@ -1,0 +1,624 @@
+//! From the TOML text to a validated [`Study`]: every check that does not need the model's
+//! matrices (values, units, exclusive keys, sizes of inline matrices).
+
+use std::ops::Range;
+use std::path::Path;
+
+use faer::Mat;
+
+use super::raw::{self, RawMatrix, RawStudy, S};
+use super::*;
+
+/// The file being validated: turns byte spans into line/column errors.
+pub(crate) struct Source<'a> {
+    pub file: &'a Path,
+    pub text: &'a str,
+}
+
+impl Source<'_> {
+    pub fn location(&self, span: &Range<usize>) -> Location {
+        location_of(self.text, span.start)
+    }
+
+    pub fn invalid(&self, span: &Range<usize>, message: impl Into<String>) -> StudyError {
+        StudyError {
+            file: self.file.to_path_buf(),
+            location: Some(self.location(span)),
+            kind: Box::new(StudyErrorKind::Invalid(message.into())),
+        }
+    }
+}
+
+/// Line and column (from 1, column in characters) of byte `offset` of `text`.
+pub(crate) fn location_of(text: &str, offset: usize) -> Location {
+    let offset = offset.min(text.len());
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    Location { line, column: before[line_start..].chars().count() + 1 }
+}
+
+pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
+    let src = Source { file, text };
+    let raw: RawStudy = toml::from_str(text).map_err(|e| StudyError {
+        file: file.to_path_buf(),
+        location: e.span().map(|s| src.location(&s)),
+        kind: Box::new(StudyErrorKind::Syntax(e.message().trim_end().to_string())),
+    })?;
+    let folder = file.parent().unwrap_or(Path::new("")).to_path_buf();
+    let resolve = |p: &str| folder.join(p);
+
+    let (model, file_damping) = model(&src, &raw.model, &resolve)?;
+    let n_inline = match &model {
+        ModelSpec::Inline { dofs, .. } => Some(dofs.len()),
+        ModelSpec::Files { dofs: DofNames::Inline(d), .. } => Some(d.len()),
+        ModelSpec::Files { .. } => None,
+    };
+    let damping = damping(&src, raw.damping.as_ref(), file_damping, n_inline)?;
+
+    let mut loads = Vec::new();
+    for l in &raw.load {
+        let ctx = format!("[[load]] {:?}", l.get_ref().name.get_ref());
+        let r = l.get_ref();
+        check_name(&src, &r.name, "[[load]]")?;
+        let placement = match (&r.dof, &r.values) {
+            (Some(d), None) => Placement::Dof(d.get_ref().clone()),
+            (None, Some(v)) => Placement::Vector(finite_list(&src, v, &ctx, "values")?),
+            _ => return Err(src.invalid(&l.span(), format!("{ctx}: give exactly one of `dof` or `values`"))),
+        };
+        let scale = match &r.scale {
+            Some(s) => finite(&src, s, &ctx, "scale")?,
+            None => 1.0,
+        };
+        let at = src.location(&r.dof.as_ref().map(|d| d.span()).unwrap_or(l.span()));
+        loads.push(LoadSpec { name: r.name.get_ref().clone(), placement, scale, at });
+    }
+    unique_names(&src, raw.load.iter().map(|l| &l.get_ref().name), "[[load]]")?;
+
+    let mut joints = Vec::new();
+    for j in &raw.joint {
+        joints.push(joint(&src, j)?);
+    }
+    unique_names(&src, raw.joint.iter().map(|j| &j.get_ref().name), "[[joint]]")?;
+
+    let excitation = excitation(&src, &raw.excitation, &loads)?;
+    let sweep = sweep(&src, &raw.sweep)?;
+    let hbm = hbm(&src, raw.harmonic_balance.as_ref())?;
+    let continuation = continuation(&src, raw.continuation.as_ref(), &sweep)?;
+
+    let mut outputs = Vec::new();
+    for o in &raw.output {
+        let r = o.get_ref();
+        check_name(&src, &r.name, "[[output]]")?;
+        let ctx = format!("[[output]] {:?}", r.name.get_ref());
+        let (placement, span) = match (&r.dof, &r.vector) {
+            (Some(d), None) => (Placement::Dof(d.get_ref().clone()), d.span()),
+            (None, Some(v)) => (Placement::Vector(finite_list(&src, v, &ctx, "vector")?), v.span()),
+            _ => return Err(src.invalid(&o.span(), format!("{ctx}: give exactly one of `dof` or `vector`"))),
+        };
+        outputs.push(OutputSelector { name: r.name.get_ref().clone(), placement, at: src.location(&span) });
+    }
+    unique_names(&src, raw.output.iter().map(|o| &o.get_ref().name), "[[output]]")?;
+    let output_options = output_options(&src, raw.output_options.as_ref())?;
+
+    Ok(Study {
+        path: file.to_path_buf(),
+        model,
+        damping,
+        loads,
+        joints,
+        excitation,
+        sweep,
+        hbm,
+        continuation,
+        outputs,
+        output_options,
+    })
+}
+
+/// Names of loads, joints and outputs become column names: ASCII letters, digits, `_`, `-`.
+fn check_name(src: &Source, name: &S<String>, section: &str) -> Result<(), StudyError> {
+    let n = name.get_ref();
+    if n.is_empty() || !n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(src.invalid(
+            &name.span(),
+            format!("{section}: name {n:?} must be non-empty and use only ASCII letters, digits, `_` and `-` (it names result columns)"),
+        ));
+    }
+    Ok(())
+}
+
+fn unique_names<'a>(src: &Source, names: impl Iterator<Item = &'a S<String>>, section: &str) -> Result<(), StudyError> {
+    let mut seen = std::collections::HashSet::new();
+    for n in names {
+        if !seen.insert(n.get_ref().as_str()) {
+            return Err(src.invalid(&n.span(), format!("{section}: name {:?} is used twice", n.get_ref())));
+        }
+    }
+    Ok(())
+}
+
+fn finite(src: &Source, v: &S<f64>, ctx: &str, key: &str) -> Result<f64, StudyError> {
+    let x = *v.get_ref();
+    if !x.is_finite() {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must be a finite number, got {x}")));
+    }
+    Ok(x)
+}
+
+/// A value that must be `> 0` (`unit` is said in the message).
+fn positive(src: &Source, v: &S<f64>, ctx: &str, key: &str, unit: &str) -> Result<f64, StudyError> {
+    let x = *v.get_ref();
+    if !(x.is_finite() && x > 0.0) {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must be > 0{unit}, got {x}")));
+    }
+    Ok(x)
+}
+
+fn non_negative(src: &Source, v: &S<f64>, ctx: &str, key: &str, unit: &str) -> Result<f64, StudyError> {
+    let x = *v.get_ref();
+    if !(x.is_finite() && x >= 0.0) {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must be >= 0{unit}, got {x}")));
+    }
+    Ok(x)
+}
+
+fn count(src: &Source, v: &S<i64>, ctx: &str, key: &str, min: i64) -> Result<usize, StudyError> {
+    let x = *v.get_ref();
+    if x < min {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must be an integer >= {min}, got {x}")));
+    }
+    Ok(x as usize)
+}
+
+fn finite_list(src: &Source, v: &S<Vec<f64>>, ctx: &str, key: &str) -> Result<Vec<f64>, StudyError> {
+    if let Some((i, x)) = v.get_ref().iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key}[{i}] must be a finite number, got {x}")));
+    }
+    if v.get_ref().is_empty() {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must not be empty")));
+    }
+    Ok(v.get_ref().clone())
+}
+
+/// An inline matrix of size `n × n` (rows, or diagonal values).
+fn matrix(src: &Source, m: &S<RawMatrix>, n: usize, ctx: &str, key: &str) -> Result<Mat<f64>, StudyError> {
+    let span = m.span();
+    let mat = match m.get_ref() {
+        RawMatrix::Diagonal(d) => {
+            if d.len() != n {
+                return Err(src.invalid(
+                    &span,
+                    format!("{ctx}: {key} has {} diagonal values, expected {n} (one per DOF)", d.len()),
+                ));
+            }
+            Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 })
+        }
+        RawMatrix::Rows(rows) => {
+            if rows.len() != n {
+                return Err(
+                    src.invalid(&span, format!("{ctx}: {key} has {} rows, expected {n} (one per DOF)", rows.len()))
+                );
+            }
+            if let Some((i, r)) = rows.iter().enumerate().find(|(_, r)| r.len() != n) {
+                return Err(src.invalid(
+                    &span,
+                    format!("{ctx}: {key} row {} has {} values, expected {n} (one per DOF)", i + 1, r.len()),
+                ));
+            }
+            Mat::from_fn(n, n, |i, j| rows[i][j])
+        }
+    };
+    for j in 0..n {
+        for i in 0..n {
+            let x = mat[(i, j)];
+            if !x.is_finite() {
+                return Err(src.invalid(&span, format!("{ctx}: {key}[{}][{}] must be finite, got {x}", i + 1, j + 1)));
+            }
+        }
+    }
+    Ok(mat)
+}
+
+fn model(
+    src: &Source,
+    m: &S<raw::RawModel>,
+    resolve: &dyn Fn(&str) -> std::path::PathBuf,
+) -> Result<(ModelSpec, Option<std::path::PathBuf>), StudyError> {
+    const CTX: &str = "[model]";
+    let r = m.get_ref();
+    let at = src.location(&m.span());
+    let inline = r.mass.is_some() || r.stiffness.is_some();
+    let files = r.mass_file.is_some() || r.stiffness_file.is_some();
+    let damping_file = r.damping_file.as_ref().map(|p| resolve(p.get_ref()));
+    if inline && files {
+        return Err(src.invalid(
+            &m.span(),
+            format!("{CTX}: give either inline `mass` and `stiffness` or `mass_file` and `stiffness_file`, not both"),
+        ));
+    }
+    if inline {
+        let (Some(dofs), Some(mass), Some(stiffness)) = (&r.dofs, &r.mass, &r.stiffness) else {
+            return Err(src.invalid(
+                &m.span(),
+                format!("{CTX}: an inline model needs `dofs` (names), `mass` (kg) and `stiffness` (N/m)"),
+            ));
+        };
+        if let Some(f) = &r.dof_file {
+            return Err(src.invalid(
+                &f.span(),
+                format!("{CTX}: `dof_file` goes with matrix files; inline models name their DOFs in `dofs`"),
+            ));
+        }
+        let names = dof_names(src, dofs)?;
+        let n = names.len();
+        let mass = matrix(src, mass, n, CTX, "mass")?;
+        let stiffness = matrix(src, stiffness, n, CTX, "stiffness")?;
+        return Ok((ModelSpec::Inline { dofs: names, mass, stiffness, at }, damping_file));
+    }
+    if files {
+        let (Some(mf), Some(kf)) = (&r.mass_file, &r.stiffness_file) else {
+            return Err(src
+                .invalid(&m.span(), format!("{CTX}: a model from files needs both `mass_file` and `stiffness_file`")));
+        };
+        let dofs = match (&r.dofs, &r.dof_file) {
+            (Some(_), Some(f)) => {
+                return Err(src
+                    .invalid(&f.span(), format!("{CTX}: give DOF names either in `dofs` or in `dof_file`, not both")))
+            }
+            (Some(d), None) => DofNames::Inline(dof_names(src, d)?),
+            (None, Some(f)) => DofNames::File(resolve(f.get_ref())),
+            (None, None) => DofNames::Numbered,
+        };
+        let at = src.location(&mf.span());
+        return Ok((
+            ModelSpec::Files { mass: resolve(mf.get_ref()), stiffness: resolve(kf.get_ref()), dofs, at },
+            damping_file,
+        ));
+    }
+    Err(src.invalid(
+        &m.span(),
+        format!("{CTX}: no model: give `dofs`, `mass` and `stiffness` inline, or `mass_file` and `stiffness_file` (Matrix Market)"),
+    ))
+}
+
+fn dof_names(src: &Source, dofs: &S<Vec<String>>) -> Result<Vec<String>, StudyError> {
+    let names = dofs.get_ref();
+    if names.is_empty() {
+        return Err(src.invalid(&dofs.span(), "[model]: dofs must list at least one DOF name"));
+    }
+    let mut seen = std::collections::HashSet::new();
+    for n in names {
+        if n.trim().is_empty() {
+            return Err(src.invalid(&dofs.span(), "[model]: DOF names must not be empty"));
+        }
+        if !seen.insert(n) {
+            return Err(src.invalid(&dofs.span(), format!("[model]: DOF {n:?} appears twice in dofs")));
+        }
+    }
+    Ok(names.clone())
+}
+
+fn damping(
+    src: &Source,
+    d: Option<&S<raw::RawDamping>>,
+    file: Option<std::path::PathBuf>,
+    n_inline: Option<usize>,
+) -> Result<DampingSpec, StudyError> {
+    const CTX: &str = "[damping]";
+    let Some(d) = d else {
+        return Ok(file.map_or(DampingSpec::None, DampingSpec::File));
+    };
+    let r = d.get_ref();
+    let given = [r.alpha.is_some() || r.beta.is_some(), r.modal_ratios.is_some(), r.matrix.is_some(), file.is_some()];
+    if given.iter().filter(|g| **g).count() > 1 {
+        return Err(src.invalid(
+            &d.span(),
+            format!("{CTX}: give one kind of damping: Rayleigh `alpha`/`beta`, `modal_ratios`, `matrix`, or [model] `damping_file`"),
+        ));
+    }
+    if r.alpha.is_some() || r.beta.is_some() {
+        let alpha = r.alpha.as_ref().map(|a| non_negative(src, a, CTX, "alpha", " 1/s")).transpose()?.unwrap_or(0.0);
+        let beta = r.beta.as_ref().map(|b| non_negative(src, b, CTX, "beta", " s")).transpose()?.unwrap_or(0.0);
+        return Ok(DampingSpec::Rayleigh { alpha, beta });
+    }
+    if let Some(z) = &r.modal_ratios {
+        let ratios = finite_list(src, z, CTX, "modal_ratios")?;
+        if let Some(x) = ratios.iter().find(|x| **x < 0.0) {
+            return Err(src.invalid(&z.span(), format!("{CTX}: modal_ratios must be >= 0, got {x}")));
+        }
+        return Ok(DampingSpec::Modal { ratios });
+    }
+    if let Some(m) = &r.matrix {
+        let Some(n) = n_inline else {
+            return Err(src.invalid(&m.span(), format!("{CTX}: an inline damping `matrix` needs the DOF names in [model] `dofs`; use [model] `damping_file` with matrix files")));
+        };
+        return Ok(DampingSpec::Matrix(matrix(src, m, n, CTX, "matrix")?));
+    }
+    Ok(file.map_or(DampingSpec::None, DampingSpec::File))
+}
+
+fn placement(
+    src: &Source,
+    r: &raw::RawJoint,
+    whole: &Range<usize>,
+    ctx: &str,
+) -> Result<(Placement, Range<usize>), StudyError> {
+    match (&r.between, &r.dof, &r.vector) {
+        (Some(b), None, None) => {
+            let pair = b.get_ref();
+            if pair.len() != 2 || pair[0] == pair[1] {
+                return Err(src.invalid(&b.span(), format!("{ctx}: between must name two different DOFs, got {pair:?}")));
+            }
+            Ok((Placement::Between(pair[0].clone(), pair[1].clone()), b.span()))
+        }
+        (None, Some(d), None) => Ok((Placement::Dof(d.get_ref().clone()), d.span())),
+        (None, None, Some(v)) => Ok((Placement::Vector(finite_list(src, v, ctx, "vector")?), v.span())),
+        _ => Err(src.invalid(
+            whole,
+            format!("{ctx}: place the joint with exactly one of `between = [\"a\", \"b\"]`, `dof = \"a\"` (to the ground) or `vector = [...]`"),
+        )),
+    }
+}
+
+fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
+    let r = j.get_ref();
+    check_name(src, &r.name, "[[joint]]")?;
+    let ctx = format!("[[joint]] {:?}", r.name.get_ref());
+    let (placement, pspan) = placement(src, r, &j.span(), &ctx)?;
+    let law_name = r.law.get_ref().as_str();
+    // Keys each law accepts, to reject parameters of another law (a likely mix-up).
+    let allowed: &[&str] = match law_name {
+        "jenkins" => &["threshold", "stiffness", "replaces_stiffness"],
+        "iwan" => &["stiffness", "replaces_stiffness", "slip_force", "sliders"],
+        "coulomb" => &["threshold", "velocity_scale"],
+        "cubic" => &["k3"],
+        other => {
+            return Err(src.invalid(
+                &r.law.span(),
+                format!("{ctx}: unknown law {other:?}, expected one of \"jenkins\", \"iwan\", \"coulomb\", \"cubic\""),
+            ))
+        }
+    };
+    let present: [(&str, Option<Range<usize>>); 7] = [
+        ("threshold", r.threshold.as_ref().map(|v| v.span())),
+        ("stiffness", r.stiffness.as_ref().map(|v| v.span())),
+        ("replaces_stiffness", r.replaces_stiffness.as_ref().map(|v| v.span())),
+        ("slip_force", r.slip_force.as_ref().map(|v| v.span())),
+        ("sliders", r.sliders.as_ref().map(|v| v.span())),
+        ("velocity_scale", r.velocity_scale.as_ref().map(|v| v.span())),
+        ("k3", r.k3.as_ref().map(|v| v.span())),
+    ];
+    for (key, span) in &present {
+        if let Some(span) = span {
+            if !allowed.contains(key) {
+                return Err(src.invalid(
+                    span,
+                    format!(
+                        "{ctx}: `{key}` is not a parameter of law {law_name:?}, which takes: {}",
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    let need = |v: &Option<S<f64>>, key: &str, unit: &str| -> Result<f64, StudyError> {
+        match v {
+            Some(v) => positive(src, v, &ctx, key, unit),
+            None => Err(src.invalid(&j.span(), format!("{ctx}: law {law_name:?} needs `{key}`{unit}"))),
+        }
+    };
+    let hysteretic_stiffness = || -> Result<JointStiffness, StudyError> {
+        let replaces = r.replaces_stiffness.as_ref().map(|b| *b.get_ref());
+        match (&r.stiffness, replaces) {
+            (Some(k), Some(true)) => Ok(JointStiffness::Replaces(positive(src, k, &ctx, "stiffness", " N/m")?)),
+            (Some(k), None | Some(false)) => Ok(JointStiffness::Own(positive(src, k, &ctx, "stiffness", " N/m")?)),
+            (None, None | Some(true)) => Ok(JointStiffness::ReplacesComputed),
+            (None, Some(false)) => Err(src.invalid(
+                &r.replaces_stiffness.as_ref().map(|b| b.span()).unwrap_or(j.span()),
+                format!("{ctx}: replaces_stiffness = false needs the joint's own `stiffness` (N/m)"),
+            )),
+        }
+    };
+    let law = match law_name {
+        "jenkins" => {
+            LawSpec::Jenkins { threshold: need(&r.threshold, "threshold", " N")?, stiffness: hysteretic_stiffness()? }
+        }
+        "iwan" => LawSpec::Iwan {
+            stiffness: hysteretic_stiffness()?,
+            slip_force: need(&r.slip_force, "slip_force", " N")?,
+            sliders: match &r.sliders {
+                Some(s) => count(src, s, &ctx, "sliders", 1)?,
+                None => 10,
+            },
+        },
+        "coulomb" => LawSpec::Coulomb {
+            threshold: need(&r.threshold, "threshold", " N")?,
+            velocity_scale: need(&r.velocity_scale, "velocity_scale", " m/s")?,
+        },
+        _ => LawSpec::Cubic {
+            k3: match &r.k3 {
+                Some(k) => finite(src, k, &ctx, "k3")?,
+                None => return Err(src.invalid(&j.span(), format!("{ctx}: law \"cubic\" needs `k3` (N/m^3)"))),
+            },
+        },
+    };
+    Ok(JointSpec { name: r.name.get_ref().clone(), law, placement, at: src.location(&pspan) })
+}
+
+fn excitation(src: &Source, e: &S<raw::RawExcitation>, loads: &[LoadSpec]) -> Result<ExcitationSpec, StudyError> {
+    const CTX: &str = "[excitation]";
+    let r = e.get_ref();
+    let load = match &r.load {
+        Some(l) => {
+            if !loads.iter().any(|x| &x.name == l.get_ref()) {
+                let known: Vec<&str> = loads.iter().map(|x| x.name.as_str()).collect();
+                return Err(src.invalid(
+                    &l.span(),
+                    format!("{CTX}: no [[load]] named {:?} (loads are: {})", l.get_ref(), known.join(", ")),
+                ));
+            }
+            Some(l.get_ref().clone())
+        }
+        None if loads.len() == 1 => None,
+        None => {
+            return Err(src.invalid(
+                &e.span(),
+                format!(
+                    "{CTX}: say which [[load]] excites the structure with `load = \"name\"` ({} loads defined)",
+                    loads.len()
+                ),
+            ))
+        }
+    };
+    let levels = finite_list(src, &r.levels, CTX, "levels")?;
+    if let Some(x) = levels.iter().find(|x| **x <= 0.0) {
+        return Err(src.invalid(&r.levels.span(), format!("{CTX}: levels must be > 0 N, got {x}")));
+    }
+    Ok(ExcitationSpec { load, levels, at: src.location(&e.span()) })
+}
+
+fn sweep(src: &Source, s: &S<raw::RawSweep>) -> Result<SweepSettings, StudyError> {
+    const CTX: &str = "[sweep]";
+    let r = s.get_ref();
+    let start_hz = positive(src, &r.start_hz, CTX, "start_hz", " Hz")?;
+    let end_hz = positive(src, &r.end_hz, CTX, "end_hz", " Hz")?;
+    if start_hz == end_hz {
+        return Err(src.invalid(
+            &r.end_hz.span(),
+            format!("{CTX}: empty band: start_hz and end_hz are both {start_hz} Hz; give two different frequencies (end_hz < start_hz sweeps down)"),
+        ));
+    }
+    let band = (end_hz - start_hz).abs();
+    let step_hz = match &r.step_hz {
+        Some(st) => {
+            let x = positive(src, st, CTX, "step_hz", " Hz")?;
+            if x > band {
+                return Err(
+                    src.invalid(&st.span(), format!("{CTX}: step_hz ({x} Hz) is larger than the band ({band} Hz)"))
+                );
+            }
+            x
+        }
+        None => band / 100.0,
+    };
+    Ok(SweepSettings { start_hz, end_hz, step_hz })
+}
+
+fn hbm(src: &Source, h: Option<&S<raw::RawHarmonicBalance>>) -> Result<HbmSettings, StudyError> {
+    const CTX: &str = "[harmonic_balance]";
+    let mut out = HbmSettings::default();
+    let Some(h) = h else { return Ok(out) };
+    let r = h.get_ref();
+    if let Some(n) = &r.harmonics {
+        out.harmonics = count(src, n, CTX, "harmonics", 1)?;
+    }
+    if let Some(s) = &r.samples {
+        out.samples = count(src, s, CTX, "samples", 1)?;
+    }
+    let min = 2 * out.harmonics + 1;
+    if out.samples < min {
+        let span = r.samples.as_ref().map(|s| s.span()).unwrap_or(h.span());
+        return Err(src.invalid(
+            &span,
+            format!("{CTX}: {} samples cannot resolve {} harmonics: samples must be >= 2 harmonics + 1 = {min} (the paper uses 300 for 7)", out.samples, out.harmonics),
+        ));
+    }
+    if let Some(t) = &r.tolerance {
+        out.tolerance = positive(src, t, CTX, "tolerance", "")?;
+    }
+    if let Some(m) = &r.max_iterations {
+        out.max_iterations = count(src, m, CTX, "max_iterations", 1)?;
+    }
+    Ok(out)
+}
+
+fn continuation(
+    src: &Source,
+    c: Option<&S<raw::RawContinuation>>,
+    sweep: &SweepSettings,
+) -> Result<ContinuationSettings, StudyError> {
+    const CTX: &str = "[continuation]";
+    let mut out = ContinuationSettings {
+        predictor: Predictor::Secant,
+        min_step_hz: sweep.step_hz / 1000.0,
+        max_step_hz: sweep.step_hz * 10.0,
+        max_points: 10_000,
+    };
+    let Some(c) = c else { return Ok(out) };
+    let r = c.get_ref();
+    if let Some(p) = &r.predictor {
+        out.predictor = match p.get_ref().as_str() {
+            "secant" => Predictor::Secant,
+            "tangent" => Predictor::Tangent,
+            "lagrange" => Predictor::Lagrange,
+            other => {
+                return Err(src.invalid(
+                    &p.span(),
+                    format!(
+                        "{CTX}: unknown predictor {other:?}, expected one of \"secant\", \"tangent\", \"lagrange\""
+                    ),
+                ))
+            }
+        };
+    }
+    if let Some(m) = &r.min_step_hz {
+        out.min_step_hz = positive(src, m, CTX, "min_step_hz", " Hz")?;
+    }
+    if let Some(m) = &r.max_step_hz {
+        out.max_step_hz = positive(src, m, CTX, "max_step_hz", " Hz")?;
+    }
+    if !(out.min_step_hz <= sweep.step_hz && sweep.step_hz <= out.max_step_hz) {
+        return Err(src.invalid(
+            &c.span(),
+            format!(
+                "{CTX}: need min_step_hz <= [sweep] step_hz <= max_step_hz, got {} <= {} <= {} Hz",
+                out.min_step_hz, sweep.step_hz, out.max_step_hz
+            ),
+        ));
+    }
+    if let Some(m) = &r.max_points {
+        out.max_points = count(src, m, CTX, "max_points", 2)?;
+    }
+    Ok(out)
+}
+
+fn output_options(src: &Source, o: Option<&S<raw::RawOutputOptions>>) -> Result<OutputOptions, StudyError> {
+    const CTX: &str = "[output_options]";
+    let mut out = OutputOptions::default();
+    let Some(o) = o else { return Ok(out) };
+    let r = o.get_ref();
+    if let Some(t) = &r.time_data {
+        out.time_data = match t.get_ref() {
+            raw::RawTimeData::Word(w) if w == "none" => TimeData::None,
+            raw::RawTimeData::Word(w) if w == "all" => TimeData::All,
+            raw::RawTimeData::Every(k) if *k >= 1 => TimeData::Every(*k as usize),
+            raw::RawTimeData::Every(k) => {
+                return Err(src.invalid(
+                    &t.span(),
+                    format!("{CTX}: time_data = k writes every k-th point and needs k >= 1, got {k}"),
+                ))
+            }
+            raw::RawTimeData::Word(w) => {
+                return Err(src.invalid(
+                    &t.span(),
+                    format!(
+                        "{CTX}: time_data must be \"none\", \"all\" or an integer k >= 1 (every k-th point), got {w:?}"
+                    ),
+                ))
+            }
+        };
+    }
+    if let Some(p) = &r.plot_format {
+        out.plot_format = match p.get_ref().as_str() {
+            "png" => PlotFormat::Png,
+            "svg" => PlotFormat::Svg,
+            other => {
+                return Err(
+                    src.invalid(&p.span(), format!("{CTX}: plot_format must be \"png\" or \"svg\", got {other:?}"))
+                )
+            }
+        };
+    }
+    Ok(out)
+}
