@@ -10,4 +10,5 @@ pub mod continuation;
 pub mod elements;
 pub mod hbm;
 pub mod model;
+pub mod signal;
 pub mod timesim;
