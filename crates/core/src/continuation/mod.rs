@@ -20,7 +20,8 @@
 //! first tangent predicts across the band (`‖dx/dλ‖ s_λ`, which sizes a sweep that starts from
 //! `x = 0`) and `‖x‖` of every point accepted since (a resonance peak rises far above its
 //! off-resonance start). A problem may fix `s_x` instead ([`Scales`]). Residuals are measured
-//! relative to a residual scale `s_R` (the problem's, or `‖R(0, λ_start)‖`: the forcing).
+//! relative to a residual scale `s_R`: the problem's, or `‖R(0, λ_start)‖` (the forcing of a
+//! forced problem), or `‖R(0, λ_end)‖` if that vanishes (a force-level sweep from zero), or 1.
 //! Step sizes ([`Options`]) are scaled arclengths.
 //!
 //! # The loop
@@ -93,7 +94,8 @@ pub trait Problem {
 pub struct Scales {
     /// Norm of a typical `x` (fixes `s_x`; default: automatic, see the module documentation).
     pub unknowns: Option<f64>,
-    /// Norm of a typical residual term, e.g. the excitation force (default `‖R(0, λ_start)‖`).
+    /// Norm of a typical residual term, e.g. the excitation force (default `‖R(0, λ_start)‖`, see the
+    /// module documentation).
     pub residual: Option<f64>,
 }
 

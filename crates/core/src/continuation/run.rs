@@ -149,17 +149,24 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let n = self.n;
         let opts = self.options;
 
-        // Residual scale: the problem's, or ‖R(0, λ_start)‖ (the forcing of a forced problem).
+        // Residual scale: the problem's, or ‖R(0, λ)‖ (the forcing of a forced problem) at
+        // λ_start, or at λ_end when it vanishes at the start (a force sweep from zero), or 1.
         self.scale.residual = match residual_scale {
             Some(s) => s,
             None => {
                 self.x_phys.iter_mut().for_each(|v| *v = 0.0);
-                match self.evaluate(self.lambda_start, false) {
-                    Ok(r) => positive_or_one(r),
-                    Err(error) => {
-                        return TerminationReason::ProblemError { lambda: self.lambda_start, last_lambda: None, error }
+                let mut scale = 0.0;
+                // A problem that cannot be evaluated at x = 0 falls back to 1; its errors are
+                // reported by the first solve.
+                for lambda in [self.lambda_start, self.lambda_end] {
+                    if let Ok(r) = self.evaluate(lambda, false) {
+                        if r.is_finite() && r > 0.0 {
+                            scale = r;
+                            break;
+                        }
                     }
                 }
+                positive_or_one(scale)
             }
         };
         self.tolerance = (opts.rtol * self.scale.residual).max(opts.atol);
