@@ -50,12 +50,12 @@ impl Study {
                 *at,
             ),
             ModelSpec::Files { mass, stiffness, dofs, at } => {
-                let m = read_matrix(mass, "[model] mass_file").map_err(|k| err(*at, k))?;
-                let k = read_matrix(stiffness, "[model] stiffness_file").map_err(|k| err(*at, k))?;
+                let m = read_matrix(mass, "[model] mass_file").map_err(|k| err(at.mass, k))?;
+                let k = read_matrix(stiffness, "[model] stiffness_file").map_err(|k| err(at.stiffness, k))?;
                 let labels = match dofs {
                     DofNames::Numbered => (1..=m.nrows()).map(|i| DofLabel::named(i.to_string())).collect(),
                     DofNames::Inline(names) => names.iter().map(|d| dof_label(d)).collect(),
-                    DofNames::File(path) => read_dof_file(path).map_err(|k| err(*at, k))?,
+                    DofNames::File(path) => read_dof_file(path).map_err(|k| err(at.section, k))?,
                 };
                 (m, k, labels, *at)
             }
@@ -66,13 +66,32 @@ impl Study {
             DampingSpec::Modal { ratios } => Damping::Modal { ratios: ratios.clone() },
             DampingSpec::Matrix(d) => Damping::Matrix(Matrix::Dense(d.clone())),
             DampingSpec::File(path) => {
-                Damping::Matrix(read_matrix(path, "[model] damping_file").map_err(|k| err(model_at, k))?)
+                Damping::Matrix(read_matrix(path, "[model] damping_file").map_err(|k| err(model_at.section, k))?)
             }
         };
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
-        let mut linear =
-            LinearModel::new(mass, stiffness, damping, dofs, Vec::new()).map_err(|e| err(model_at, model_error(e)))?;
-        check_mass_positive_definite(&linear.mass).map_err(|e| err(model_at, model_error(e)))?;
+        // Point at the matrix a model error is about.
+        let model_error_at = |e: &ModelError| match e {
+            ModelError::MassNotPositiveDefinite => model_at.mass,
+            ModelError::WrongSize { what, .. }
+            | ModelError::NotSymmetric { what, .. }
+            | ModelError::NotFinite { what }
+                if what.starts_with('M') =>
+            {
+                model_at.mass
+            }
+            ModelError::WrongSize { what, .. }
+            | ModelError::NotSymmetric { what, .. }
+            | ModelError::NotFinite { what }
+                if what.starts_with('K') =>
+            {
+                model_at.stiffness
+            }
+            _ => model_at.section,
+        };
+        let mut linear = LinearModel::new(mass, stiffness, damping, dofs, Vec::new())
+            .map_err(|e| err(model_error_at(&e), model_error(e)))?;
+        check_mass_positive_definite(&linear.mass).map_err(|e| err(model_error_at(&e), model_error(e)))?;
 
         for l in &self.loads {
             let ctx = format!("[[load]] {:?}", l.name);
@@ -119,7 +138,7 @@ impl Study {
             outs
         };
 
-        let model = NonlinearModel::new(linear, sites).map_err(|e| err(model_at, model_error(e)))?;
+        let model = NonlinearModel::new(linear, sites).map_err(|e| err(model_at.section, model_error(e)))?;
         Ok((model, excitation, outputs))
     }
 

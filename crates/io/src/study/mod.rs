@@ -49,10 +49,19 @@ pub struct Location {
 #[derive(Clone, Debug)]
 pub enum ModelSpec {
     /// Small matrices written in the study file (kg, N/m), with their DOF names.
-    Inline { dofs: Vec<String>, mass: Mat<f64>, stiffness: Mat<f64>, at: Location },
+    Inline { dofs: Vec<String>, mass: Mat<f64>, stiffness: Mat<f64>, at: ModelLocations },
     /// Matrix Market files (paths already resolved against the study folder) and optional DOF
     /// names (a `dof_file` or an inline `dofs` list; otherwise the DOFs are named "1", "2", ...).
-    Files { mass: PathBuf, stiffness: PathBuf, dofs: DofNames, at: Location },
+    Files { mass: PathBuf, stiffness: PathBuf, dofs: DofNames, at: ModelLocations },
+}
+
+/// Where the `[model]` section and its mass and stiffness keys are, for errors found when the
+/// model is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ModelLocations {
+    pub section: Location,
+    pub mass: Location,
+    pub stiffness: Location,
 }
 
 /// DOF names of a model read from files.

@@ -38,12 +38,39 @@ pub(crate) fn location_of(text: &str, offset: usize) -> Location {
     Location { line, column: before[line_start..].chars().count() + 1 }
 }
 
+/// The table header (`[model]`, `[[joint]]`, ...) in force at byte `offset`, to say where a
+/// parser error is when its message does not.
+fn section_at(text: &str, offset: usize) -> Option<&str> {
+    let line_start = text[..offset.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next().unwrap_or("").trim_start();
+    // An error on a header line itself is about the header: no prefix.
+    if is_header(line) {
+        return None;
+    }
+    text[..line_start].lines().rev().map(str::trim).find(|l| is_header(l)).map(|l| match l.rfind(']') {
+        Some(end) => &l[..=end],
+        None => l,
+    })
+}
+
+/// `[name]` or `[[name]]`, not a row of a matrix written over several lines (`[1.0, 2.0]`).
+fn is_header(line: &str) -> bool {
+    line.starts_with('[') && line.trim_start_matches('[').starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+}
+
 pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     let src = Source { file, text };
-    let raw: RawStudy = toml::from_str(text).map_err(|e| StudyError {
-        file: file.to_path_buf(),
-        location: e.span().map(|s| src.location(&s)),
-        kind: Box::new(StudyErrorKind::Syntax(e.message().trim_end().to_string())),
+    let raw: RawStudy = toml::from_str(text).map_err(|e| {
+        let message = e.message().trim_end();
+        let message = match e.span().and_then(|s| section_at(text, s.start)) {
+            Some(section) => format!("{section}: {message}"),
+            None => message.to_string(),
+        };
+        StudyError {
+            file: file.to_path_buf(),
+            location: e.span().map(|s| src.location(&s)),
+            kind: Box::new(StudyErrorKind::Syntax(message)),
+        }
     })?;
     let folder = file.parent().unwrap_or(Path::new("")).to_path_buf();
     let resolve = |p: &str| folder.join(p);
@@ -252,6 +279,11 @@ fn model(
         }
         let names = dof_names(src, dofs)?;
         let n = names.len();
+        let at = ModelLocations {
+            section: at,
+            mass: src.location(&mass.span()),
+            stiffness: src.location(&stiffness.span()),
+        };
         let mass = matrix(src, mass, n, CTX, "mass")?;
         let stiffness = matrix(src, stiffness, n, CTX, "stiffness")?;
         return Ok((ModelSpec::Inline { dofs: names, mass, stiffness, at }, damping_file));
@@ -270,7 +302,7 @@ fn model(
             (None, Some(f)) => DofNames::File(resolve(f.get_ref())),
             (None, None) => DofNames::Numbered,
         };
-        let at = src.location(&mf.span());
+        let at = ModelLocations { section: at, mass: src.location(&mf.span()), stiffness: src.location(&kf.span()) };
         return Ok((
             ModelSpec::Files { mass: resolve(mf.get_ref()), stiffness: resolve(kf.get_ref()), dofs, at },
             damping_file,

@@ -1,0 +1,176 @@
+//! Result files read back give the numbers written, bit for bit.
+
+use std::path::PathBuf;
+
+use stickslip_io::output::{
+    frf_columns, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_time_data, ElementRecord,
+    LevelResult, OutputRecord, PointRecord,
+};
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("stickslip-io-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Awkward numbers: not representable in few decimals, tiny, huge, negative.
+fn value(seed: usize) -> f64 {
+    let x = (seed as f64 + 1.0) * std::f64::consts::PI / 7.0;
+    x.sin() * 10f64.powi((seed % 17) as i32 - 8) / 3.0
+}
+
+fn point(f: f64, seed: usize, n_t: usize) -> PointRecord {
+    let harmonics = harmonics_from_coefficients(&(0..15).map(|i| value(seed + i)).collect::<Vec<_>>());
+    let series = |s: usize| (0..n_t).map(|j| value(s + j)).collect::<Vec<f64>>();
+    PointRecord {
+        frequency_hz: f,
+        iterations: seed % 5,
+        residual: value(seed).abs(),
+        outputs: vec![
+            OutputRecord {
+                name: "mass".into(),
+                disp_frf: value(seed + 1),
+                accel_frf: value(seed + 2),
+                peak: value(seed + 3),
+                harmonics: harmonics.clone(),
+                disp: series(seed),
+                vel: series(seed + 1),
+            },
+            OutputRecord { name: "slider-P".into(), harmonics, ..Default::default() },
+        ],
+        elements: vec![ElementRecord {
+            name: "joint_1".into(),
+            energy_j: value(seed + 4),
+            stick_fraction: 0.25,
+            loop_u: series(seed + 2),
+            loop_force: series(seed + 3),
+            slider_velocity: series(seed + 4),
+        }],
+    }
+}
+
+fn levels(n_t: usize) -> Vec<LevelResult> {
+    vec![
+        LevelResult { level_n: 100.0, points: (0..5).map(|i| point(150.0 + i as f64 * 0.1, i, n_t)).collect() },
+        LevelResult { level_n: 1000.0, points: (0..3).map(|i| point(350.0 - i as f64 / 3.0, 40 + i, 0)).collect() },
+    ]
+}
+
+fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()).collect()).collect();
+    (header, rows)
+}
+
+#[test]
+fn harmonics_are_amplitude_and_phase_of_cosines() {
+    // c cos θ + s sin θ with c = 3, s = −4 is 5 cos(θ + atan2(4, 3)): exact up to round-off.
+    let h = harmonics_from_coefficients(&[-0.5, 3.0, -4.0]);
+    assert_eq!(h[0], (-0.5, 0.0));
+    assert!((h[1].0 - 5.0).abs() < 1e-15 && (h[1].1 - 4f64.atan2(3.0)).abs() < 1e-15);
+}
+
+#[test]
+fn frf_csv_reads_back_exactly() {
+    let dir = scratch_dir("csv");
+    let levels = levels(0);
+    write_frf_csv(&dir.join("frf.csv"), &levels).unwrap();
+    let (header, rows) = read_csv(&dir.join("frf.csv"));
+    assert_eq!(&header[..4], ["level_N", "frequency_Hz", "newton_iterations", "residual_rel"]);
+    assert_eq!(&header[4..7], ["mass_disp_frf_m_per_N", "mass_accel_frf_m_s2_per_N", "mass_peak_m"]);
+    assert_eq!(&header[7..9], ["mass_h0_amp_m", "mass_h0_phase_rad"]);
+    assert_eq!(header.last().unwrap(), "joint_1_stick_fraction");
+    // 4 + per output 3 + 2 (N+1) with N = 7, + 2 per element.
+    assert_eq!(header.len(), 4 + 2 * (3 + 16) + 2);
+    assert_eq!(header, frf_columns(&levels[0].points[0]));
+    assert_eq!(rows.len(), 8);
+    let mut r = 0;
+    for l in &levels {
+        for p in &l.points {
+            let row = &rows[r];
+            assert_eq!(row[0], l.level_n);
+            assert_eq!(row[1], p.frequency_hz);
+            assert_eq!(row[2], p.iterations as f64);
+            assert_eq!(row[3], p.residual);
+            assert_eq!(row[4], p.outputs[0].disp_frf);
+            assert_eq!(row[7 + 2 * 5], p.outputs[0].harmonics[5].0);
+            assert_eq!(row[7 + 2 * 5 + 1], p.outputs[0].harmonics[5].1);
+            assert_eq!(row[header.len() - 2], p.elements[0].energy_j);
+            r += 1;
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn points_of_different_shape_are_refused() {
+    let dir = scratch_dir("csv-shape");
+    let mut levels = levels(0);
+    levels[1].points[2].outputs[0].harmonics.pop();
+    let msg = write_frf_csv(&dir.join("frf.csv"), &levels).unwrap_err().to_string();
+    assert!(msg.starts_with("level 1000 N, point at"), "{msg}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn time_data_reads_back_exactly() {
+    let dir = scratch_dir("time");
+    let n_t = 300;
+    let levels = levels(n_t);
+    // Only the first level's points carry time data.
+    assert_eq!(write_time_data(&dir, &levels).unwrap(), 5);
+    let (header, rows) = read_csv(&dir.join("points/level0_point3.csv"));
+    assert_eq!(
+        header,
+        [
+            "theta_rad",
+            "time_s",
+            "mass_disp_m",
+            "mass_vel_m_s",
+            "joint_1_u_m",
+            "joint_1_force_N",
+            "joint_1_slider_vel_m_s"
+        ]
+    );
+    assert_eq!(rows.len(), n_t);
+    let p = &levels[0].points[3];
+    for (j, row) in rows.iter().enumerate() {
+        let theta = 2.0 * std::f64::consts::PI * j as f64 / n_t as f64;
+        assert_eq!(row[0], theta);
+        assert_eq!(row[1], theta / (2.0 * std::f64::consts::PI * p.frequency_hz));
+        assert_eq!(row[2], p.outputs[0].disp[j]);
+        assert_eq!(row[6], p.elements[0].slider_velocity[j]);
+    }
+    assert!(!dir.join("points/level1_point0.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn frf_npz_reads_back_exactly() {
+    let dir = scratch_dir("npz");
+    let levels = levels(0);
+    let path = dir.join("frf.npz");
+    write_frf_npz(&path, &levels).unwrap();
+    let mut npz = npyz::npz::NpzArchive::open(&path).unwrap();
+    let read = |npz: &mut npyz::npz::NpzArchive<_>, name: &str| {
+        let arr = npz.by_name(name).unwrap().unwrap_or_else(|| panic!("array {name} missing"));
+        let shape = arr.shape().to_vec();
+        (shape, arr.into_vec::<f64>().unwrap())
+    };
+    let (shape, level) = read(&mut npz, "level_N");
+    assert_eq!(shape, [8]);
+    assert_eq!(level, [100.0, 100.0, 100.0, 100.0, 100.0, 1000.0, 1000.0, 1000.0]);
+    let (_, f) = read(&mut npz, "frequency_Hz");
+    assert_eq!(f[6], levels[1].points[1].frequency_hz);
+    let (_, e) = read(&mut npz, "joint_1_energy_J");
+    assert_eq!(e[2], levels[0].points[2].elements[0].energy_j);
+    let (shape, amps) = read(&mut npz, "slider-P_harmonics_amp_m");
+    assert_eq!(shape, [8, 8]);
+    // Row-major (C order), as numpy reads it: row 6 = level 1, point 1.
+    assert_eq!(amps[6 * 8 + 3], levels[1].points[1].outputs[1].harmonics[3].0);
+    let (_, h3) = read(&mut npz, "slider-P_h3_amp_m");
+    assert_eq!(h3[6], amps[6 * 8 + 3]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

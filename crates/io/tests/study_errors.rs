@@ -1,0 +1,142 @@
+//! Bad study files give an error naming the file, the line and column, the key and what is
+//! expected; never a panic, never a silently wrong model.
+
+use stickslip_io::study::Study;
+
+/// A valid 2-DOF study; each test breaks one line of it.
+const GOOD: &str = r#"[model]
+dofs = ["a", "b"]
+mass = [[2.0, 0.0], [0.0, 1.0]]
+stiffness = [[3.0e4, -1.0e4], [-1.0e4, 1.0e4]]
+
+[damping]
+alpha = 2.0
+
+[[load]]
+name = "push"
+dof = "a"
+
+[[joint]]
+name = "j1"
+law = "jenkins"
+between = ["a", "b"]
+threshold = 5.0
+
+[excitation]
+levels = [1.0, 2.0]
+
+[sweep]
+start_hz = 10.0
+end_hz = 30.0
+"#;
+
+/// `GOOD` with `from` replaced by `to` (which must occur once).
+fn broken(from: &str, to: &str) -> String {
+    assert_eq!(GOOD.matches(from).count(), 1, "{from:?} must occur once in GOOD");
+    GOOD.replace(from, to)
+}
+
+fn parse_error(text: &str) -> String {
+    Study::parse(text, "study.toml").expect_err("the study must be rejected").to_string()
+}
+
+fn build_error(text: &str) -> String {
+    let study = Study::parse(text, "study.toml").expect("the study parses");
+    study.build_model().expect_err("the model must be rejected").to_string()
+}
+
+#[test]
+fn the_good_study_builds() {
+    let (model, excitation, outputs) = Study::parse(GOOD, "study.toml").unwrap().build_model().unwrap();
+    assert_eq!(model.elements.len(), 1);
+    // Paper form by default: k = VᵀKV along e_a − e_b = K_aa + K_bb − 2 K_ab = 6e4 N/m.
+    assert_eq!(model.elements[0].directions, vec![vec![1.0, -1.0]]);
+    assert_eq!(excitation.levels_n, vec![1.0, 2.0]);
+    // No [[output]]: every DOF of a small model is reported.
+    assert_eq!(outputs.len(), 2);
+}
+
+#[test]
+fn malformed_toml_names_line_and_column() {
+    let msg = parse_error(&broken("[damping]", "[damping"));
+    assert!(msg.starts_with("study.toml:6:9: "), "{msg}");
+}
+
+#[test]
+fn unknown_key_lists_the_valid_keys() {
+    let msg = parse_error(&broken("threshold = 5.0", "threshhold = 5.0"));
+    assert!(msg.starts_with("study.toml:17:1: [[joint]]: unknown field"), "{msg}");
+    assert!(msg.contains("unknown field `threshhold`") && msg.contains("`threshold`"), "{msg}");
+}
+
+#[test]
+fn wrong_type_says_what_is_expected() {
+    let msg = parse_error(&broken("levels = [1.0, 2.0]", "levels = \"high\""));
+    assert!(msg.starts_with("study.toml:20:10: ") && msg.contains("expected a sequence"), "{msg}");
+}
+
+#[test]
+fn missing_section_is_named() {
+    let msg = parse_error(&GOOD.replace("[sweep]\nstart_hz = 10.0\nend_hz = 30.0\n", ""));
+    assert!(msg.contains("missing field `sweep`"), "{msg}");
+}
+
+#[test]
+fn wrong_matrix_size_is_rejected() {
+    let msg = parse_error(&broken("[-1.0e4, 1.0e4]]", "[-1.0e4, 1.0e4, 0.0]]"));
+    assert_eq!(msg, "study.toml:4:13: [model]: stiffness row 2 has 3 values, expected 2 (one per DOF)");
+    let msg = parse_error(&broken("mass = [[2.0, 0.0], [0.0, 1.0]]", "mass = [2.0]"));
+    assert_eq!(msg, "study.toml:3:8: [model]: mass has 1 diagonal values, expected 2 (one per DOF)");
+}
+
+#[test]
+fn non_symmetric_stiffness_is_rejected() {
+    let msg = build_error(&broken("[-1.0e4, 1.0e4]]", "[-1.1e4, 1.0e4]]"));
+    assert!(msg.starts_with("study.toml:4:13: [model]: K (stiffness) is not symmetric"), "{msg}");
+}
+
+#[test]
+fn indefinite_mass_is_rejected() {
+    // Eigenvalues 3 and -1: symmetric, not positive definite.
+    let msg = build_error(&broken("mass = [[2.0, 0.0], [0.0, 1.0]]", "mass = [[1.0, 2.0], [2.0, 1.0]]"));
+    assert!(msg.starts_with("study.toml:3:8: [model]: the mass matrix is not positive definite"), "{msg}");
+}
+
+#[test]
+fn negative_threshold_is_rejected() {
+    let msg = parse_error(&broken("threshold = 5.0", "threshold = -3"));
+    assert_eq!(msg, "study.toml:17:13: [[joint]] \"j1\": threshold must be > 0 N, got -3");
+}
+
+#[test]
+fn empty_band_is_rejected() {
+    let msg = parse_error(&broken("end_hz = 30.0", "end_hz = 10.0"));
+    assert!(msg.starts_with("study.toml:24:10: [sweep]: empty band"), "{msg}");
+}
+
+#[test]
+fn unknown_dof_names_the_known_ones() {
+    let msg = build_error(&broken("between = [\"a\", \"b\"]", "between = [\"a\", \"c\"]"));
+    assert_eq!(msg, "study.toml:16:11: [[joint]] \"j1\": no DOF named \"c\" in the model (DOFs are: a, b)");
+}
+
+#[test]
+fn parameter_of_another_law_is_rejected() {
+    let msg = parse_error(&broken("threshold = 5.0", "threshold = 5.0\nk3 = 1.0"));
+    assert!(msg.starts_with("study.toml:18:6: [[joint]] \"j1\": `k3` is not a parameter of law \"jenkins\""), "{msg}");
+}
+
+#[test]
+fn too_few_samples_for_the_harmonics() {
+    let msg = parse_error(&format!("{GOOD}\n[harmonic_balance]\nharmonics = 7\nsamples = 14\n"));
+    assert!(msg.contains("samples must be >= 2 harmonics + 1 = 15"), "{msg}");
+}
+
+#[test]
+fn missing_matrix_file_names_the_file() {
+    let text = GOOD
+        .replace("mass = [[2.0, 0.0], [0.0, 1.0]]", "mass_file = \"no-such-mass.mtx\"")
+        .replace("stiffness = [[3.0e4, -1.0e4], [-1.0e4, 1.0e4]]", "stiffness_file = \"k.mtx\"");
+    let msg = build_error(&text);
+    assert!(msg.contains("[model] mass_file") && msg.contains("no-such-mass.mtx"), "{msg}");
+}
