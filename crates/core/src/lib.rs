@@ -10,5 +10,6 @@ pub mod continuation;
 pub mod elements;
 pub mod hbm;
 pub mod model;
+pub mod post;
 pub mod signal;
 pub mod timesim;

@@ -85,6 +85,14 @@ impl Element for Iwan {
         }
     }
 
+    fn replaced_stiffness(&self) -> f64 {
+        if self.replaces_stiffness {
+            self.stiffness()
+        } else {
+            0.0
+        }
+    }
+
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], mut tangent: Option<&mut Tangent>) {
         let s = self.stiffnesses.len();
         let mut total = 0.0;

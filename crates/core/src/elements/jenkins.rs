@@ -70,6 +70,14 @@ impl Element for Jenkins {
         }
     }
 
+    fn replaced_stiffness(&self) -> f64 {
+        if self.replaces_stiffness {
+            self.stiffness
+        } else {
+            0.0
+        }
+    }
+
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>) {
         let (k, fc) = (self.stiffness, self.threshold);
         let trial = k * (u[0] - state[0]);

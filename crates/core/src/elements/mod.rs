@@ -113,6 +113,12 @@ pub trait Element: Send + Sync + std::fmt::Debug {
     /// partial derivatives (the tangent is cleared by the caller).
     fn update(&self, u: &[f64], v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>);
 
+    /// Stiffness of the linear model that the element replaces (paper form, Eq. 11: `k_J`), so
+    /// that the joint's own force is `f = g + k_J u`; 0 for elements that add to the model.
+    fn replaced_stiffness(&self) -> f64 {
+        0.0
+    }
+
     /// Is the element slipping over this step (state before → after)? Used for the stick
     /// fraction and the slider velocity (Eq. 33). Memoryless laws never stick.
     fn is_slipping(&self, state_before: &[f64], state_after: &[f64]) -> bool {

@@ -52,6 +52,8 @@ pub enum HbmError {
     Aft(#[from] AftError),
     #[error("the model has no nonlinear element: nothing to condense on (a linear FRF needs no harmonic balance)")]
     NoElements,
+    #[error("Newton did not converge at {frequency_hz:.4} Hz, level {level} after {iterations} iterations (relative residual {residual:.3e}); try more harmonics, a closer start or a smaller step")]
+    NoConvergence { frequency_hz: f64, level: f64, iterations: usize, residual: f64 },
     #[error("the excitation pattern has length {got}, expected {expected}")]
     ForceLength { got: usize, expected: usize },
 }
@@ -286,6 +288,47 @@ impl<'m> CondensedHbm<'m> {
                 dl[sin_index(1) * q + i] = hr.u_force[i].im;
             }
         }
+    }
+
+    /// Newton's method at fixed (Ω, λ_F) from `x0`, to `‖R‖ ≤ tolerance · ‖x‖` (R is a
+    /// displacement, so the test is relative to the motion itself). Returns the solution and the
+    /// number of iterations.
+    pub fn solve(
+        &mut self,
+        omega: f64,
+        level: f64,
+        x0: &[f64],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(Vec<f64>, usize), HbmError> {
+        use faer::linalg::solvers::Solve;
+        let n = self.dimension();
+        let mut x = x0.to_vec();
+        let mut r = vec![0.0; n];
+        let mut jac = Mat::zeros(n, n);
+        let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let mut rel = f64::INFINITY;
+        for it in 0..=max_iterations {
+            self.evaluate(&x, omega, level, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))?;
+            rel = norm(&r) / norm(&x).max(f64::MIN_POSITIVE);
+            if rel <= tolerance {
+                return Ok((x, it));
+            }
+            if it == max_iterations {
+                break;
+            }
+            let rhs = Mat::from_fn(n, 1, |i, _| r[i]);
+            let dx = jac.partial_piv_lu().solve(&rhs);
+            for i in 0..n {
+                x[i] -= dx[(i, 0)];
+            }
+        }
+        Err(HbmError::NoConvergence {
+            frequency_hz: omega / (2.0 * std::f64::consts::PI),
+            level,
+            iterations: max_iterations,
+            residual: rel,
+        })
     }
 
     /// AFT of every element (Eq. 15): `G(x)` and, if `want`, `∂G/∂x`, `∂G/∂Ω`, assembled from

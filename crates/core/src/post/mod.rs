@@ -1,0 +1,178 @@
+//! Results at a converged point (paper Sections 4.4, 5): harmonics and FRFs of any physical
+//! DOF (recovered by Eq. 27), the elements' hysteresis loops, stick fraction, slider velocity
+//! (Eq. 33) and the energy balance over one cycle.
+
+use faer::c64;
+
+use crate::hbm::condensed::{complex_amplitude, CondensedHbm, HbmError};
+use crate::hbm::fourier::{amplitude_phase, cos_index, sin_index};
+
+/// A quantity to report: a name and the vector `o` such that the reported motion is `oᵀ U`
+/// (a unit vector for a DOF).
+#[derive(Clone, Debug)]
+pub struct OutputSelector {
+    pub name: String,
+    pub vector: Vec<f64>,
+}
+
+/// Motion of one output over a period.
+#[derive(Clone, Debug)]
+pub struct OutputResult {
+    pub name: String,
+    /// Coefficient vector `[c0, c1, s1, ...]` (m).
+    pub coeffs: Vec<f64>,
+    /// Displacement samples over one period at θ_j = 2πj/n_t (m).
+    pub displacement: Vec<f64>,
+    /// Velocity samples (m/s).
+    pub velocity: Vec<f64>,
+    /// max_j |x(θ_j)| (m).
+    pub peak: f64,
+}
+
+impl OutputResult {
+    /// Amplitude (m) and phase (rad, relative to the force's cos Ωt) of harmonic `k ≥ 1`;
+    /// for `k = 0`, the mean and 0.
+    pub fn harmonic(&self, k: usize) -> (f64, f64) {
+        if k == 0 {
+            (self.coeffs[0], 0.0)
+        } else {
+            amplitude_phase(&self.coeffs, k)
+        }
+    }
+}
+
+/// Response of one element over a period.
+#[derive(Clone, Debug)]
+pub struct ElementResult {
+    pub name: String,
+    /// Energy dissipated per cycle, `∮ g du` (J).
+    pub energy_per_cycle: f64,
+    /// Fraction of the period during which the element sticks.
+    pub stick_fraction: f64,
+    /// Relative displacement `u = Vᵀ U` over the period (m), first direction.
+    pub displacement: Vec<f64>,
+    /// The joint's own force (N): `f = g + k_J u` for a paper-form element (Eq. 11).
+    pub force: Vec<f64>,
+    /// Slider velocity (Eq. 33): 0 when stuck, `u̇` when slipping (m/s).
+    pub slider_velocity: Vec<f64>,
+}
+
+/// Everything reported at one converged point.
+#[derive(Clone, Debug)]
+pub struct PointResult {
+    /// Fundamental circular frequency (rad/s).
+    pub omega: f64,
+    /// Force level λ_F (N per unit pattern).
+    pub level: f64,
+    pub outputs: Vec<OutputResult>,
+    pub elements: Vec<ElementResult>,
+    /// Work of the excitation per cycle (J).
+    pub excitation_work: f64,
+    /// Energy dissipated per cycle by viscous damping (J).
+    pub viscous_dissipation: f64,
+}
+
+impl PointResult {
+    pub fn frequency_hz(&self) -> f64 {
+        self.omega / (2.0 * std::f64::consts::PI)
+    }
+
+    /// Energy balance defect per cycle relative to the excitation work:
+    /// `(W_F − W_visc − Σ W_e) / W_F`.
+    pub fn energy_balance_error(&self) -> f64 {
+        let friction: f64 = self.elements.iter().map(|e| e.energy_per_cycle).sum();
+        (self.excitation_work - self.viscous_dissipation - friction) / self.excitation_work
+    }
+}
+
+/// Post-process a converged solution `x` of `hbm` at (Ω, λ_F).
+pub fn evaluate_point(
+    hbm: &mut CondensedHbm<'_>,
+    x: &[f64],
+    omega: f64,
+    level: f64,
+    outputs: &[OutputSelector],
+) -> Result<PointResult, HbmError> {
+    let q = hbm.n_directions();
+    let mut residual = vec![0.0; hbm.dimension()];
+    // Fills the elements' time samples and force harmonics at x.
+    hbm.evaluate(x, omega, level, &mut residual, None)?;
+    let plan = hbm.plan();
+    let (nh, nc, nt) = (plan.n_harmonics(), plan.n_coeffs(), plan.n_samples());
+    let g = hbm.element_force_harmonics().to_vec();
+    let pi = std::f64::consts::PI;
+
+    // Outputs and the excitation pattern, recovered harmonic by harmonic (Eq. 27).
+    let force = hbm.force().to_vec();
+    let mut selectors: Vec<&[f64]> = outputs.iter().map(|o| o.vector.as_slice()).collect();
+    selectors.push(&force);
+    let mut coeffs = vec![vec![0.0; nc]; selectors.len()];
+    let mut viscous = 0.0;
+    let g0: Vec<c64> = (0..q).map(|i| c64::new(g[i], 0.0)).collect();
+    let (mean, _) = hbm.receptance().recover(0.0, 0.0, &g0, &selectors);
+    for (c, m) in coeffs.iter_mut().zip(&mean) {
+        c[0] = m.re;
+    }
+    for k in 1..=nh {
+        let gk: Vec<c64> = (0..q).map(|i| complex_amplitude(&g, q, k, i)).collect();
+        let lk = if k == 1 { level } else { 0.0 };
+        let (amps, udu) = hbm.receptance().recover(k as f64 * omega, lk, &gk, &selectors);
+        // ∫₀ᵀ U̇ᵀ D U̇ dt = π Ω Σ_k k² Uᴴ D U.
+        viscous += pi * omega * (k * k) as f64 * udu;
+        for (c, a) in coeffs.iter_mut().zip(&amps) {
+            c[cos_index(k)] = a.re;
+            c[sin_index(k)] = -a.im;
+        }
+    }
+    // W_F = λ_F ∫ cos θ Fᵀ dU/dθ dθ = π λ_F Fᵀ s_1.
+    let excitation_work = pi * level * coeffs.last().expect("pattern row")[sin_index(1)];
+
+    let mut scratch = plan.scratch();
+    let mut output_results = Vec::with_capacity(outputs.len());
+    for (o, c) in outputs.iter().zip(&coeffs) {
+        let mut displacement = vec![0.0; nt];
+        let mut velocity = vec![0.0; nt];
+        plan.synthesize(c, &mut displacement, &mut scratch);
+        plan.synthesize_derivative(c, &mut velocity, &mut scratch);
+        velocity.iter_mut().for_each(|v| *v *= omega);
+        let peak = displacement.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        output_results.push(OutputResult { name: o.name.clone(), coeffs: c.clone(), displacement, velocity, peak });
+    }
+
+    let mut element_results = Vec::new();
+    let mut offset = 0;
+    for (e, site) in hbm.model().elements.iter().enumerate() {
+        let d = site.law.n_dirs();
+        // ∮ g du = π Σ_k k (s_k g_ck − c_k g_sk), exact for the truncated motion.
+        let mut energy = 0.0;
+        for a in offset..offset + d {
+            for k in 1..=nh {
+                let (ic, is) = (cos_index(k) * q + a, sin_index(k) * q + a);
+                energy += pi * k as f64 * (x[is] * g[ic] - x[ic] * g[is]);
+            }
+        }
+        let aft = hbm.element_aft(e);
+        let kj = site.law.replaced_stiffness();
+        let displacement = aft.u[..nt].to_vec();
+        let force = (0..nt).map(|j| aft.g[j] + kj * aft.u[j]).collect();
+        let slider_velocity = (0..nt).map(|j| if aft.slipping[j] { aft.v[j] } else { 0.0 }).collect();
+        let stuck = aft.slipping.iter().filter(|s| !**s).count();
+        element_results.push(ElementResult {
+            name: site.name.clone(),
+            energy_per_cycle: energy,
+            stick_fraction: stuck as f64 / nt as f64,
+            displacement,
+            force,
+            slider_velocity,
+        });
+        offset += d;
+    }
+    Ok(PointResult {
+        omega,
+        level,
+        outputs: output_results,
+        elements: element_results,
+        excitation_work,
+        viscous_dissipation: viscous,
+    })
+}
