@@ -4,7 +4,7 @@
 
 use faer::MatMut;
 use stickslip_core::continuation::{
-    continue_branch, Branch, Options, Point, Predictor, Problem, ProblemError, Silent, TerminationReason,
+    continue_branch, Branch, Options, Point, Predictor, Problem, ProblemError, Scales, Silent, TerminationReason,
 };
 
 /// x² + λ² = 1.
@@ -250,4 +250,64 @@ fn observer_sees_every_point_with_monotone_progress() {
     let total: usize = branch.points.iter().map(|p| p.calls.residuals).sum();
     // The residual-scale evaluation R(0, λ_start) belongs to the first point.
     assert_eq!(total, branch.calls.residuals);
+}
+
+/// The S-curve with the unknown's scale fixed to 1, so that the scaled variables are known
+/// outside: z = (x, λ / 10) on the interval [−5, 5].
+struct SCurveUnitScale;
+
+impl Problem for SCurveUnitScale {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        SCurve.evaluate(x, lambda, residual, jacobian)
+    }
+    fn scales(&self) -> Scales {
+        Scales { unknowns: Some(1.0), residual: None }
+    }
+}
+
+/// Largest turn between consecutive secants in the scaled variables (x, λ/10), the last
+/// point (placed at λ_end by a fixed-λ solve, not by a checked step) left out.
+fn largest_turn(points: &[Point]) -> f64 {
+    let secants: Vec<(f64, f64)> = points[..points.len() - 1]
+        .windows(2)
+        .map(|w| (w[1].x[0] - w[0].x[0], (w[1].lambda - w[0].lambda) / 10.0))
+        .collect();
+    secants
+        .windows(2)
+        .map(|w| {
+            ((w[0].0 * w[1].0 + w[0].1 * w[1].1) / (w[0].0.hypot(w[0].1) * w[1].0.hypot(w[1].1)))
+                .clamp(-1.0, 1.0)
+                .acos()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_angle_check_bounds_the_turn_between_consecutive_secants() {
+    for predictor in PREDICTORS {
+        // Coarse steps (0.3 of the scaled band) around folds whose radius of curvature in the
+        // scaled variables is 1/0.6 (μ = λ/10 = (x³ − 3x)/10 has μ'' = 0.6 at x = ±1): turns
+        // of ~0.2 rad per step.
+        let coarse = Options { predictor, initial_step: 0.3, max_step: 0.3, ..Options::default() };
+        let checked = run(&mut SCurveUnitScale, -2.0, -5.0, 5.0, &Options { max_angle: 0.1, ..coarse.clone() });
+        let unchecked =
+            run(&mut SCurveUnitScale, -2.0, -5.0, 5.0, &Options { max_angle: std::f64::consts::PI, ..coarse });
+        for branch in [&checked, &unchecked] {
+            assert_eq!(branch.termination, TerminationReason::ReachedEnd, "{predictor:?}");
+            assert_eq!(reversals(&branch.points), 2, "{predictor:?}");
+        }
+        // Without the check the turns at the folds exceed 0.1 rad (so this test can fail);
+        // with it, none does (1e-12: rounding of the recomputed secants).
+        assert!(largest_turn(&unchecked.points) > 0.1, "{predictor:?}: {}", largest_turn(&unchecked.points));
+        assert!(largest_turn(&checked.points) <= 0.1 + 1e-12, "{predictor:?}: {}", largest_turn(&checked.points));
+    }
 }

@@ -273,6 +273,8 @@ pub enum ContinuationError {
     InvalidOption { name: &'static str, value: f64, expected: &'static str },
     #[error("the initial guess has {len} unknowns, expected {expected} (the problem's dimension)")]
     WrongGuessLength { len: usize, expected: usize },
+    #[error("the initial guess has a value that is not finite (NaN or infinity) at index {index}")]
+    NonFiniteGuess { index: usize },
     #[error("the continuation interval [{start}, {end}] is empty or not finite: give two different finite values")]
     EmptyInterval { start: f64, end: f64 },
     #[error("the problem's {name} scale is {value}, expected a positive finite value")]

@@ -8,9 +8,9 @@ use super::{
 
 /// Follow the solution curve of `problem` from `λ_start` (solved from `x_guess`) to `λ_end`.
 ///
-/// Invalid input (options, guess length, interval, scales) is an `Err`; everything that happens
-/// during the continuation, including failures, is a [`TerminationReason`] in the returned
-/// [`Branch`], which keeps every converged point.
+/// Invalid input (options, guess, interval, scales) is an `Err`; everything that happens during
+/// the continuation, failures included, is a [`TerminationReason`] in the returned [`Branch`],
+/// which keeps every converged point.
 pub fn continue_branch<P: Problem + ?Sized, O: Observer + ?Sized>(
     problem: &mut P,
     x_guess: &[f64],
@@ -23,6 +23,9 @@ pub fn continue_branch<P: Problem + ?Sized, O: Observer + ?Sized>(
     let n = problem.dimension();
     if x_guess.len() != n {
         return Err(ContinuationError::WrongGuessLength { len: x_guess.len(), expected: n });
+    }
+    if let Some(index) = x_guess.iter().position(|v| !v.is_finite()) {
+        return Err(ContinuationError::NonFiniteGuess { index });
     }
     if !(lambda_start.is_finite() && lambda_end.is_finite()) || lambda_start == lambda_end {
         return Err(ContinuationError::EmptyInterval { start: lambda_start, end: lambda_end });
@@ -38,15 +41,17 @@ pub fn continue_branch<P: Problem + ?Sized, O: Observer + ?Sized>(
     let mut runner = Runner::new(problem, options, lambda_start, lambda_end);
     runner.scale.x_fixed = scales.unknowns.is_some();
     runner.scale.x = scales.unknowns.unwrap_or_else(|| positive_or_one(norm(x_guess)));
-    Ok(runner.run(x_guess, scales.residual, observer))
+    let mut points = Vec::new();
+    let termination = runner.run(x_guess, scales.residual, observer, &mut points);
+    Ok(Branch { points, termination, calls: runner.total })
 }
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
 }
 
 fn positive_or_one(v: f64) -> f64 {
@@ -55,15 +60,6 @@ fn positive_or_one(v: f64) -> f64 {
     } else {
         1.0
     }
-}
-
-/// `out = [x / s_x, λ / s_λ]`.
-fn to_scaled(x: &[f64], lambda: f64, scale: &Scaling, out: &mut [f64]) {
-    let n = x.len();
-    for (o, xi) in out[..n].iter_mut().zip(x) {
-        *o = xi / scale.x;
-    }
-    out[n] = lambda / scale.lambda;
 }
 
 /// `z = [x / s_x, λ / s_λ]`, residuals relative to `s_R` (Eq. 31's α = (s_x/s_λ)²).
@@ -75,10 +71,85 @@ struct Scaling {
     x_fixed: bool,
 }
 
+impl Scaling {
+    /// `out = [x / s_x, λ / s_λ]`.
+    fn to_scaled(&self, x: &[f64], lambda: f64, out: &mut [f64]) {
+        let n = x.len();
+        for (o, xi) in out[..n].iter_mut().zip(x) {
+            *o = xi / self.x;
+        }
+        out[n] = lambda / self.lambda;
+    }
+
+    /// A physical direction `[dx, dλ]` in scaled variables, in place.
+    fn direction_to_scaled(&self, v: &mut [f64]) {
+        let n = v.len() - 1;
+        v[..n].iter_mut().for_each(|a| *a /= self.x);
+        v[n] /= self.lambda;
+    }
+
+    /// A scaled direction in physical units `[dx, dλ]`, in place.
+    fn direction_to_physical(&self, v: &mut [f64]) {
+        let n = v.len() - 1;
+        v[..n].iter_mut().for_each(|a| *a *= self.x);
+        v[n] *= self.lambda;
+    }
+}
+
+/// The equation closing the Newton system besides `R = 0`.
+#[derive(Clone, Copy)]
+enum Constraint {
+    /// `tᵀ (z − z_pred) = 0`: the hyperplane orthogonal to the prediction (Eq. 32).
+    Arclength,
+    /// `λ` fixed (first point, interval ends).
+    FixedLambda(f64),
+}
+
 enum Outcome {
     Converged { iterations: usize, residual_norm: f64 },
     Failed { iterations: usize, residual_norm: f64 },
     Problem { lambda: f64, error: ProblemError },
+}
+
+/// Step length and the bookkeeping of the attempts since the last accepted point.
+struct StepControl {
+    step: f64,
+    just_rejected: bool,
+    attempts: usize,
+    failed_iterations: usize,
+}
+
+impl StepControl {
+    /// ADAPT STEP after a rejection: halve. Returns the termination when below `min_step`.
+    fn reject(
+        &mut self,
+        iterations: usize,
+        residual_norm: f64,
+        last_lambda: f64,
+        options: &Options,
+    ) -> Option<TerminationReason> {
+        self.failed_iterations += iterations;
+        self.attempts += 1;
+        self.step *= 0.5;
+        self.just_rejected = true;
+        (self.step < options.min_step).then_some(TerminationReason::StepTooSmall {
+            lambda: last_lambda,
+            residual_norm,
+            attempts: self.attempts,
+            iterations: self.failed_iterations,
+        })
+    }
+
+    /// ADAPT STEP after an acceptance: grow after an easy correction, unless the step was just
+    /// cut (it would oscillate between failing and succeeding lengths).
+    fn accept(&mut self, iterations: usize, options: &Options) {
+        if !self.just_rejected && iterations <= options.easy_iterations {
+            self.step = (self.step * options.growth).min(options.max_step);
+        }
+        self.just_rejected = false;
+        self.attempts = 0;
+        self.failed_iterations = 0;
+    }
 }
 
 struct Runner<'a, P: ?Sized> {
@@ -90,20 +161,25 @@ struct Runner<'a, P: ?Sized> {
     /// +1 when λ_end > λ_start, −1 otherwise.
     direction: f64,
     scale: Scaling,
+    /// `max(rtol s_R, atol)`.
     tolerance: f64,
     ws: Workspace,
     /// Calls for the point being computed, and for the whole branch.
     calls: Calls,
     total: Calls,
-    /// Newton iterate (scaled), prediction, prediction direction, last point (scaled).
+    // Scaled vectors of length n + 1: Newton iterate, prediction, unit prediction direction,
+    // last two-but-one, one-but-last and last points, and a scratch reference direction.
     z: Vec<f64>,
     z_pred: Vec<f64>,
     t: Vec<f64>,
+    z_older: Vec<f64>,
+    z_old: Vec<f64>,
     z_last: Vec<f64>,
+    reference: Vec<f64>,
     /// Physical `x` handed to the problem.
     x_phys: Vec<f64>,
-    /// Previous step direction in physical units `[dx, dλ]`: the last secant, or the tangent at
-    /// the first point; and the tangent at the last point (tangent predictor).
+    /// Physical `[dx, dλ]`: the previous step's direction (the last secant, or the tangent at
+    /// the first point), for the angle check; and the tangent at the last point.
     previous_direction: Vec<f64>,
     tangent: Vec<f64>,
 }
@@ -111,6 +187,7 @@ struct Runner<'a, P: ?Sized> {
 impl<'a, P: Problem + ?Sized> Runner<'a, P> {
     fn new(problem: &'a mut P, options: &'a Options, lambda_start: f64, lambda_end: f64) -> Self {
         let n = problem.dimension();
+        let zeros = vec![0.0; n + 1];
         Runner {
             problem,
             options,
@@ -123,23 +200,20 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             ws: Workspace::new(n),
             calls: Calls::default(),
             total: Calls::default(),
-            z: vec![0.0; n + 1],
-            z_pred: vec![0.0; n + 1],
-            t: vec![0.0; n + 1],
-            z_last: vec![0.0; n + 1],
+            z: zeros.clone(),
+            z_pred: zeros.clone(),
+            t: zeros.clone(),
+            z_older: zeros.clone(),
+            z_old: zeros.clone(),
+            z_last: zeros.clone(),
+            reference: zeros.clone(),
             x_phys: vec![0.0; n],
-            previous_direction: vec![0.0; n + 1],
-            tangent: vec![0.0; n + 1],
+            previous_direction: zeros.clone(),
+            tangent: zeros,
         }
     }
 
-    fn run<O: Observer + ?Sized>(&mut self, x_guess: &[f64], residual_scale: Option<f64>, observer: &mut O) -> Branch {
-        let mut points: Vec<Point> = Vec::new();
-        let termination = self.run_inner(x_guess, residual_scale, observer, &mut points);
-        Branch { points, termination, calls: self.total }
-    }
-
-    fn run_inner<O: Observer + ?Sized>(
+    fn run<O: Observer + ?Sized>(
         &mut self,
         x_guess: &[f64],
         residual_scale: Option<f64>,
@@ -147,135 +221,98 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         points: &mut Vec<Point>,
     ) -> TerminationReason {
         let n = self.n;
-        let opts = self.options;
-
-        // Residual scale: the problem's, or ‖R(0, λ)‖ (the forcing of a forced problem) at
-        // λ_start, or at λ_end when it vanishes at the start (a force sweep from zero), or 1.
-        self.scale.residual = match residual_scale {
-            Some(s) => s,
-            None => {
-                self.x_phys.iter_mut().for_each(|v| *v = 0.0);
-                let mut scale = 0.0;
-                // A problem that cannot be evaluated at x = 0 falls back to 1; its errors are
-                // reported by the first solve.
-                for lambda in [self.lambda_start, self.lambda_end] {
-                    if let Ok(r) = self.evaluate(lambda, false) {
-                        if r.is_finite() && r > 0.0 {
-                            scale = r;
-                            break;
-                        }
-                    }
-                }
-                positive_or_one(scale)
-            }
-        };
-        self.tolerance = (opts.rtol * self.scale.residual).max(opts.atol);
+        let options = self.options;
+        self.scale.residual = residual_scale.unwrap_or_else(|| self.default_residual_scale());
+        self.tolerance = (options.rtol * self.scale.residual).max(options.atol);
 
         // First point: Newton at fixed λ_start from the caller's guess.
-        to_scaled(x_guess, self.lambda_start, &self.scale, &mut self.z);
-        let (iterations, residual_norm) = match self.newton(None, self.lambda_start, opts.first_point_max_iterations) {
-            Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
-            Outcome::Failed { iterations, residual_norm } => {
-                return TerminationReason::FirstPointFailed { lambda: self.lambda_start, residual_norm, iterations }
-            }
-            Outcome::Problem { lambda, error } => {
-                return TerminationReason::ProblemError { lambda, last_lambda: None, error }
-            }
-        };
+        self.scale.to_scaled(x_guess, self.lambda_start, &mut self.z);
+        let (iterations, residual_norm) =
+            match self.newton(Constraint::FixedLambda(self.lambda_start), options.first_point_max_iterations) {
+                Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
+                Outcome::Failed { iterations, residual_norm } => {
+                    return TerminationReason::FirstPointFailed { lambda: self.lambda_start, residual_norm, iterations }
+                }
+                Outcome::Problem { lambda, error } => {
+                    return TerminationReason::ProblemError { lambda, last_lambda: None, error }
+                }
+            };
+        let first = self.make_point(self.lambda_start, iterations, residual_norm, 0.0, 0);
 
-        // Initial tangent, oriented towards λ_end; it also sizes s_x for a start at x = 0.
-        self.t.iter_mut().for_each(|v| *v = 0.0);
-        self.t[n] = self.direction;
-        let reference = self.t.clone();
-        if !self.tangent_at_last_point(&reference) {
-            self.tangent.copy_from_slice(&reference);
+        // Initial tangent, oriented towards λ_end (a pure λ step if the start is singular).
+        self.reference.iter_mut().for_each(|v| *v = 0.0);
+        self.reference[n] = self.direction;
+        if !self.tangent_at_last_point() {
+            self.tangent.copy_from_slice(&self.reference);
         }
-        let x0: Vec<f64> = self.z[..n].iter().map(|u| u * self.scale.x).collect();
-        for i in 0..n {
-            self.previous_direction[i] = self.tangent[i] * self.scale.x;
-        }
-        self.previous_direction[n] = self.tangent[n] * self.scale.lambda;
+        self.scale.direction_to_physical(&mut self.tangent);
+        self.previous_direction.copy_from_slice(&self.tangent);
         if !self.scale.x_fixed {
-            let dx_dlambda = norm(&self.previous_direction[..n]) / self.previous_direction[n].abs();
+            // s_x: ‖x₀‖, or the change of x the tangent predicts across the band, whichever
+            // is larger (a sweep from x = 0 has only the latter).
+            let dx_dlambda = norm(&self.tangent[..n]) / self.tangent[n].abs();
             let across_band = if dx_dlambda.is_finite() { dx_dlambda * self.scale.lambda } else { 0.0 };
-            self.scale.x = positive_or_one(norm(&x0).max(across_band));
+            self.scale.x = positive_or_one(norm(&first.x).max(across_band));
         }
-        self.tangent.copy_from_slice(&self.previous_direction);
-        let first = Point {
-            x: x0,
-            lambda: self.lambda_start,
-            iterations,
-            residual_norm,
-            step: 0.0,
-            rejected: 0,
-            calls: self.calls,
-        };
-        self.calls = Calls::default();
-        let mut furthest = 0.0;
         observer.on_point(&first, 0.0);
         points.push(first);
 
-        let mut step = opts.initial_step;
-        let mut just_rejected = false;
-        let mut attempts = 0usize;
-        let mut failed_iterations = 0usize;
+        let mut control =
+            StepControl { step: options.initial_step, just_rejected: false, attempts: 0, failed_iterations: 0 };
+        let mut furthest = 0.0;
         loop {
-            if points.len() >= opts.max_points {
+            if points.len() >= options.max_points {
                 return TerminationReason::MaxPoints;
             }
-            let last = points.last().expect("the first point is stored");
-            to_scaled(&last.x, last.lambda, &self.scale, &mut self.z_last);
+            let last_lambda = points[points.len() - 1].lambda;
 
             // PREDICT
-            self.predict(points, step);
+            self.predict(points, control.step);
 
             // CORRECT (Eq. 32)
             self.z.copy_from_slice(&self.z_pred);
-            let outcome = self.newton(Some(()), 0.0, opts.max_iterations);
+            let outcome = self.newton(Constraint::Arclength, options.max_iterations);
 
             // ACCEPT-REJECT
             let (iterations, residual_norm) = match outcome {
-                Outcome::Problem { lambda, error } => {
-                    return TerminationReason::ProblemError { lambda, last_lambda: Some(last.lambda), error }
-                }
-                Outcome::Failed { iterations, residual_norm } => {
-                    failed_iterations += iterations;
-                    attempts += 1;
-                    step *= 0.5;
-                    just_rejected = true;
-                    if step < opts.min_step {
-                        return TerminationReason::StepTooSmall {
-                            lambda: last.lambda,
-                            residual_norm,
-                            attempts,
-                            iterations: failed_iterations,
-                        };
-                    }
-                    continue;
-                }
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
+                Outcome::Failed { iterations, residual_norm } => {
+                    match control.reject(iterations, residual_norm, last_lambda, options) {
+                        Some(termination) => return termination,
+                        None => continue,
+                    }
+                }
+                Outcome::Problem { lambda, error } => {
+                    return TerminationReason::ProblemError { lambda, last_lambda: Some(last_lambda), error }
+                }
             };
-            let mut acceptable = self.correction_distance() <= step && self.turn_angle() <= opts.max_angle;
             let lambda_new = self.z[n] * self.scale.lambda;
             let beyond_end = (lambda_new - self.lambda_end) * self.direction >= 0.0;
             let before_start = (lambda_new - self.lambda_start) * self.direction < 0.0;
-            if acceptable && before_start && points.len() == 1 {
-                // The first step is oriented towards λ_end: going back is a bad correction.
-                acceptable = false;
-            }
+            // A corrector that travelled farther than the step has likely jumped to another
+            // part of the curve; a secant turning sharply has cut a fold too coarsely; the
+            // first step is oriented towards λ_end, so going back is a bad correction.
+            // A turn that persists after the step was halved four times is a corner of a
+            // non-smooth branch (a stick/slip onset makes the curve only C0 there), not a fold
+            // cut too coarsely: halving further would never reduce it.
+            let corner = control.attempts >= 4;
+            let mut acceptable = distance(&self.z, &self.z_pred) <= control.step
+                && (self.turn_angle() <= options.max_angle || corner)
+                && !(before_start && points.len() == 1);
+
+            // TERMINATE at an interval end: solve again at exactly that λ from the guess
+            // interpolated between the last point and the one beyond.
             if acceptable && (beyond_end || before_start) {
-                // TERMINATE: solve again at exactly the interval end, from the interpolated guess.
                 let boundary = if beyond_end { self.lambda_end } else { self.lambda_start };
-                let theta = (boundary - last.lambda) / (lambda_new - last.lambda);
+                let theta = (boundary - last_lambda) / (lambda_new - last_lambda);
                 for i in 0..n {
-                    let u_last = self.z_last[i];
-                    self.z[i] = u_last + theta * (self.z[i] - u_last);
+                    self.z[i] = self.z_last[i] + theta * (self.z[i] - self.z_last[i]);
                 }
                 self.z[n] = boundary / self.scale.lambda;
-                match self.newton(None, boundary, opts.max_iterations) {
+                match self.newton(Constraint::FixedLambda(boundary), options.max_iterations) {
                     Outcome::Converged { iterations, residual_norm } => {
-                        let distance = self.distance_from_last();
-                        let point = self.make_point(boundary, iterations, residual_norm, distance, attempts);
+                        let step = distance(&self.z, &self.z_last);
+                        let point = self.make_point(boundary, iterations, residual_norm, step, control.attempts);
                         observer.on_point(&point, if beyond_end { 1.0 } else { furthest });
                         points.push(point);
                         return if beyond_end {
@@ -284,50 +321,36 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                             TerminationReason::ReturnedToStart
                         };
                     }
-                    Outcome::Problem { lambda, error } => {
-                        return TerminationReason::ProblemError { lambda, last_lambda: Some(last.lambda), error }
-                    }
                     Outcome::Failed { .. } => acceptable = false,
+                    Outcome::Problem { lambda, error } => {
+                        return TerminationReason::ProblemError { lambda, last_lambda: Some(last_lambda), error }
+                    }
                 }
             }
             if !acceptable {
-                failed_iterations += iterations;
-                attempts += 1;
-                step *= 0.5;
-                just_rejected = true;
-                if step < opts.min_step {
-                    return TerminationReason::StepTooSmall {
-                        lambda: last.lambda,
-                        residual_norm,
-                        attempts,
-                        iterations: failed_iterations,
-                    };
+                match control.reject(iterations, residual_norm, last_lambda, options) {
+                    Some(termination) => return termination,
+                    None => continue,
                 }
-                continue;
             }
 
-            // Accepted.
-            let last_x_lambda = (last.lambda, points.len());
-            let point = self.make_point(lambda_new, iterations, residual_norm, step, attempts);
-            for i in 0..n {
-                self.previous_direction[i] = (self.z[i] - self.z_last[i]) * self.scale.x;
+            // Accepted: record the step direction, the tangent for the next prediction, and
+            // let s_x follow the largest ‖x‖.
+            let point = self.make_point(lambda_new, iterations, residual_norm, control.step, control.attempts);
+            for i in 0..=n {
+                self.previous_direction[i] = self.z[i] - self.z_last[i];
             }
-            self.previous_direction[n] = lambda_new - last_x_lambda.0;
-            if opts.predictor == Predictor::Tangent {
-                // The Jacobian buffer holds ∂R at the accepted point: orient its null vector
-                // along the step just taken.
-                for i in 0..=n {
-                    self.t[i] = self.z[i] - self.z_last[i];
-                }
-                let reference = self.t.clone();
-                if self.tangent_at_last_point(&reference) {
-                    for i in 0..n {
-                        self.tangent[i] *= self.scale.x;
-                    }
-                    self.tangent[n] *= self.scale.lambda;
-                } else {
-                    self.tangent.copy_from_slice(&self.previous_direction);
-                }
+            // The workspace holds ∂R at the accepted point: the tangent there, oriented along
+            // the step taken (the secant if the bordered matrix is singular).
+            let tangent_found = options.predictor == Predictor::Tangent && {
+                self.reference.copy_from_slice(&self.previous_direction);
+                self.tangent_at_last_point()
+            };
+            self.scale.direction_to_physical(&mut self.previous_direction);
+            if tangent_found {
+                self.scale.direction_to_physical(&mut self.tangent);
+            } else {
+                self.tangent.copy_from_slice(&self.previous_direction);
             }
             if !self.scale.x_fixed {
                 self.scale.x = self.scale.x.max(norm(&point.x));
@@ -338,88 +361,93 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             points.push(point);
 
             // ADAPT STEP
-            if !just_rejected && iterations <= opts.easy_iterations {
-                step = (step * opts.growth).min(opts.max_step);
-            }
-            just_rejected = false;
-            attempts = 0;
-            failed_iterations = 0;
+            control.accept(iterations, options);
         }
     }
 
-    /// Fill `z_pred` and the unit prediction direction `t` from the last points.
+    /// `‖R(0, λ)‖` (the forcing of a forced problem) at λ_start, or at λ_end when it vanishes
+    /// at the start (a force-level sweep from zero), or 1. A problem that cannot be evaluated
+    /// at x = 0 gets 1; its errors are reported by the first solve.
+    fn default_residual_scale(&mut self) -> f64 {
+        self.x_phys.iter_mut().for_each(|v| *v = 0.0);
+        for lambda in [self.lambda_start, self.lambda_end] {
+            if let Ok(r) = self.evaluate(lambda, false) {
+                if r.is_finite() && r > 0.0 {
+                    return r;
+                }
+            }
+        }
+        1.0
+    }
+
+    /// PREDICT: fill `z_last`, `z_pred` and the unit prediction direction `t`.
     fn predict(&mut self, points: &[Point], step: f64) {
         let n = self.n;
-        let (sx, sl) = (self.scale.x, self.scale.lambda);
-        let scaling = &self.scale;
-        let scaled = |p: &Point, out: &mut [f64]| to_scaled(&p.x, p.lambda, scaling, out);
-        let use_tangent = points.len() == 1 || self.options.predictor == Predictor::Tangent;
-        if use_tangent || points.len() == 2 || self.options.predictor == Predictor::Secant {
-            if use_tangent {
-                self.t.copy_from_slice(&self.tangent);
-            } else {
-                scaled(&points[points.len() - 2], &mut self.t);
-                for i in 0..n {
-                    self.t[i] = (self.z_last[i] - self.t[i]) * sx;
+        let count = points.len();
+        let last = &points[count - 1];
+        self.scale.to_scaled(&last.x, last.lambda, &mut self.z_last);
+        let predictor = match (self.options.predictor, count) {
+            (_, 1) | (Predictor::Tangent, _) => Predictor::Tangent,
+            (Predictor::Lagrange, 3..) => Predictor::Lagrange,
+            _ => Predictor::Secant,
+        };
+        match predictor {
+            Predictor::Tangent | Predictor::Secant => {
+                if predictor == Predictor::Tangent {
+                    self.t.copy_from_slice(&self.tangent);
+                    self.scale.direction_to_scaled(&mut self.t);
+                } else {
+                    let previous = &points[count - 2];
+                    self.scale.to_scaled(&previous.x, previous.lambda, &mut self.z_old);
+                    for i in 0..=n {
+                        self.t[i] = self.z_last[i] - self.z_old[i];
+                    }
                 }
-                self.t[n] = (self.z_last[n] - self.t[n]) * sl;
+                let length = norm(&self.t);
+                for i in 0..=n {
+                    self.t[i] /= length;
+                    self.z_pred[i] = self.z_last[i] + step * self.t[i];
+                }
             }
-            // `t` holds a physical direction: scale it, normalise it, step along it.
-            for i in 0..n {
-                self.t[i] /= sx;
+            Predictor::Lagrange => {
+                // Second-degree Lagrange polynomial through z_{i−2}, z_{i−1}, z_i at their
+                // cumulative chord lengths s = −(d₁ + d₂), −d₂, 0 (Eq. 31), evaluated at s = h;
+                // the correction is orthogonal to z_pred − z_i (Eq. 32).
+                let (older, old) = (&points[count - 3], &points[count - 2]);
+                self.scale.to_scaled(&older.x, older.lambda, &mut self.z_older);
+                self.scale.to_scaled(&old.x, old.lambda, &mut self.z_old);
+                let d1 = distance(&self.z_older, &self.z_old);
+                let d2 = distance(&self.z_old, &self.z_last);
+                let (s0, s1, s) = (-(d1 + d2), -d2, step);
+                let l0 = (s - s1) * s / ((s0 - s1) * s0);
+                let l1 = (s - s0) * s / ((s1 - s0) * s1);
+                let l2 = (s - s0) * (s - s1) / (s0 * s1);
+                for i in 0..=n {
+                    self.z_pred[i] = l0 * self.z_older[i] + l1 * self.z_old[i] + l2 * self.z_last[i];
+                    self.t[i] = self.z_pred[i] - self.z_last[i];
+                }
+                let length = norm(&self.t);
+                self.t.iter_mut().for_each(|v| *v /= length);
             }
-            self.t[n] /= sl;
-            let length = norm(&self.t);
-            for i in 0..=n {
-                self.t[i] /= length;
-                self.z_pred[i] = self.z_last[i] + step * self.t[i];
-            }
-            return;
         }
-        // Second-degree Lagrange polynomial through z_{i−2}, z_{i−1}, z_i at cumulative chord
-        // lengths s = −(d₁ + d₂), −d₂, 0 (Eq. 31), evaluated at s = h.
-        let mut z0 = vec![0.0; n + 1];
-        let mut z1 = vec![0.0; n + 1];
-        scaled(&points[points.len() - 3], &mut z0);
-        scaled(&points[points.len() - 2], &mut z1);
-        let d1 = z0.iter().zip(&z1).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
-        let d2 = z1.iter().zip(&self.z_last).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
-        let (s0, s1, s2, s) = (-(d1 + d2), -d2, 0.0, step);
-        let l0 = (s - s1) * (s - s2) / ((s0 - s1) * (s0 - s2));
-        let l1 = (s - s0) * (s - s2) / ((s1 - s0) * (s1 - s2));
-        let l2 = (s - s0) * (s - s1) / ((s2 - s0) * (s2 - s1));
-        for i in 0..=n {
-            self.z_pred[i] = l0 * z0[i] + l1 * z1[i] + l2 * self.z_last[i];
-            self.t[i] = self.z_pred[i] - self.z_last[i];
-        }
-        let length = norm(&self.t);
-        self.t.iter_mut().for_each(|v| *v /= length);
-    }
-
-    /// Scaled distance between the corrected and the predicted point.
-    fn correction_distance(&self) -> f64 {
-        self.z.iter().zip(&self.z_pred).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt()
-    }
-
-    fn distance_from_last(&self) -> f64 {
-        self.z.iter().zip(&self.z_last).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt()
     }
 
     /// Angle between the new secant and the previous step direction, in scaled variables.
     fn turn_angle(&self) -> f64 {
         let n = self.n;
-        let (mut d, mut a2, mut b2) = (0.0, 0.0, 0.0);
+        let (mut dot, mut a2, mut b2) = (0.0, 0.0, 0.0);
         for i in 0..=n {
             let s = if i < n { self.scale.x } else { self.scale.lambda };
             let a = self.z[i] - self.z_last[i];
             let b = self.previous_direction[i] / s;
-            d += a * b;
+            dot += a * b;
             a2 += a * a;
             b2 += b * b;
         }
-        (d / (a2 * b2).sqrt()).clamp(-1.0, 1.0).acos()
+        (dot / (a2 * b2).sqrt()).clamp(-1.0, 1.0).acos()
     }
 
+    /// The point at the current iterate; resets the per-point call counts.
     fn make_point(&mut self, lambda: f64, iterations: usize, residual_norm: f64, step: f64, rejected: usize) -> Point {
         let point = Point {
             x: self.z[..self.n].iter().map(|u| u * self.scale.x).collect(),
@@ -434,35 +462,34 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         point
     }
 
-    /// Evaluate at `x_phys`, `lambda`; returns `‖R‖`.
+    /// Evaluate the problem at `x_phys`, `lambda`; returns `‖R‖`.
     fn evaluate(&mut self, lambda: f64, with_jacobian: bool) -> Result<f64, ProblemError> {
         let (residual, jx, dl) = self.ws.evaluation_buffers();
-        let mut calls = Calls { residuals: 1, ..Calls::default() };
-        let result = if with_jacobian {
-            calls.jacobians = 1;
-            self.problem.evaluate(&self.x_phys, lambda, residual, Some((jx, dl)))
-        } else {
-            self.problem.evaluate(&self.x_phys, lambda, residual, None)
-        };
+        let calls = Calls { residuals: 1, jacobians: usize::from(with_jacobian), factorizations: 0 };
         self.calls += calls;
         self.total += calls;
-        result.map(|()| norm(&self.ws.residual))
+        let jacobian = if with_jacobian { Some((jx, dl)) } else { None };
+        self.problem.evaluate(&self.x_phys, lambda, residual, jacobian)?;
+        Ok(norm(&self.ws.residual))
     }
 
-    /// Newton from `z`: on the bordered system of Eq. 32 (`bordered = Some(())`, hyperplane
-    /// `tᵀ(z − z_pred) = 0`) or at fixed `lambda` (`None`). The last evaluation leaves the
-    /// Jacobian at the returned point in the workspace.
-    fn newton(&mut self, bordered: Option<()>, lambda: f64, max_iterations: usize) -> Outcome {
+    /// CORRECT: Newton from `z` under `constraint`, to `‖R‖ ≤ tolerance`. Every evaluation
+    /// includes the Jacobian, so the workspace holds ∂R at the returned point (for the
+    /// tangent), at the cost of one Jacobian per point that a converged check does not need.
+    fn newton(&mut self, constraint: Constraint, max_iterations: usize) -> Outcome {
         let n = self.n;
         let mut iterations = 0;
         loop {
-            let lambda_k = if bordered.is_some() { self.z[n] * self.scale.lambda } else { lambda };
-            for i in 0..n {
-                self.x_phys[i] = self.z[i] * self.scale.x;
+            let lambda = match constraint {
+                Constraint::Arclength => self.z[n] * self.scale.lambda,
+                Constraint::FixedLambda(lambda) => lambda,
+            };
+            for (x, u) in self.x_phys.iter_mut().zip(&self.z) {
+                *x = u * self.scale.x;
             }
-            let residual_norm = match self.evaluate(lambda_k, true) {
+            let residual_norm = match self.evaluate(lambda, true) {
                 Ok(r) => r,
-                Err(error) => return Outcome::Problem { lambda: lambda_k, error },
+                Err(error) => return Outcome::Problem { lambda, error },
             };
             if !residual_norm.is_finite() {
                 return Outcome::Failed { iterations, residual_norm };
@@ -474,48 +501,46 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 return Outcome::Failed { iterations, residual_norm };
             }
             let sr = self.scale.residual;
-            for i in 0..n {
-                self.ws.rhs[i] = -self.ws.residual[i] / sr;
+            for (b, r) in self.ws.rhs.iter_mut().zip(&self.ws.residual) {
+                *b = -r / sr;
             }
             self.calls.factorizations += 1;
             self.total.factorizations += 1;
-            let solved = if bordered.is_some() {
-                let mut offset = 0.0;
-                for i in 0..=n {
-                    offset += self.t[i] * (self.z[i] - self.z_pred[i]);
+            let (solved, size) = match constraint {
+                Constraint::Arclength => {
+                    let offset: f64 = (0..=n).map(|i| self.t[i] * (self.z[i] - self.z_pred[i])).sum();
+                    self.ws.rhs[n] = -offset;
+                    (self.ws.solve_bordered(self.scale.x, self.scale.lambda, sr, &self.t), n + 1)
                 }
-                self.ws.rhs[n] = -offset;
-                self.ws.solve_bordered(self.scale.x, self.scale.lambda, sr, &self.t)
-            } else {
-                self.ws.solve_fixed(self.scale.x, sr)
+                Constraint::FixedLambda(_) => (self.ws.solve_fixed(self.scale.x, sr), n),
             };
             if !solved {
                 return Outcome::Failed { iterations, residual_norm };
             }
-            let size = if bordered.is_some() { n + 1 } else { n };
-            for i in 0..size {
-                self.z[i] += self.ws.rhs[i];
+            for (z, dz) in self.z[..size].iter_mut().zip(&self.ws.rhs) {
+                *z += dz;
             }
             iterations += 1;
         }
     }
 
-    /// Unit null vector of `∂R/∂z` at the last Newton point (Jacobian still in the workspace),
-    /// oriented along `reference`, into `tangent` (scaled). False if the bordered matrix is
-    /// singular.
-    fn tangent_at_last_point(&mut self, reference: &[f64]) -> bool {
+    /// Unit null vector of `∂R/∂z` at the last Newton point (its Jacobian is still in the
+    /// workspace), from the bordered system `[∂R/∂z; referenceᵀ] τ = [0; 1]`, oriented along
+    /// `reference`, into `tangent` (scaled). False, `tangent` untouched, if it is singular.
+    fn tangent_at_last_point(&mut self) -> bool {
         let n = self.n;
         self.ws.rhs.iter_mut().for_each(|v| *v = 0.0);
         self.ws.rhs[n] = 1.0;
         self.calls.factorizations += 1;
         self.total.factorizations += 1;
-        if !self.ws.solve_bordered(self.scale.x, self.scale.lambda, self.scale.residual, reference) {
+        if !self.ws.solve_bordered(self.scale.x, self.scale.lambda, self.scale.residual, &self.reference) {
             return false;
         }
         let length = norm(&self.ws.rhs);
-        let sign = if dot(&self.ws.rhs, reference) < 0.0 { -1.0 } else { 1.0 };
-        for i in 0..=n {
-            self.tangent[i] = sign * self.ws.rhs[i] / length;
+        let along: f64 = self.ws.rhs.iter().zip(&self.reference).map(|(a, b)| a * b).sum();
+        let sign = if along < 0.0 { -1.0 } else { 1.0 };
+        for (t, v) in self.tangent.iter_mut().zip(&self.ws.rhs) {
+            *t = sign * v / length;
         }
         true
     }
