@@ -40,7 +40,7 @@
 //! reversal inside a slipping step leaves the slider off by O(h²), and the next slip resets it
 //! (`w = u ∓ F_c/k`), so errors do not accumulate: the slider does not drift.
 
-use super::operator::{effective_solver, mass_solver, DampingOperator, SpdSolver};
+use super::operator::{effective_solver, mass_solver, LinearOperators, SpdSolver};
 use super::TimesimError;
 use crate::elements::Tangent;
 use crate::model::NonlinearModel;
@@ -143,7 +143,7 @@ pub struct Integrator<'m> {
     gamma: f64,
     c0: f64,
     c1: f64,
-    damping: DampingOperator,
+    operators: LinearOperators,
     solver: SpdSolver,
     /// Application vectors, direction-major: direction `a` is `dirs[a*n..(a+1)*n]`.
     dirs: Vec<f64>,
@@ -203,8 +203,8 @@ impl<'m> Integrator<'m> {
         let n = lin.n_dofs();
         let c0 = 1.0 / (beta * step * step);
         let c1 = gamma / (beta * step);
-        let damping = DampingOperator::new(lin)?;
-        let solver = effective_solver(lin, &damping, c0, (1.0 + alpha) * c1, 1.0 + alpha)?;
+        let operators = LinearOperators::new(lin)?;
+        let solver = effective_solver(lin, &operators, c0, (1.0 + alpha) * c1, 1.0 + alpha)?;
         let q = model.n_directions();
         let dirs: Vec<f64> = model.application_vectors().flat_map(|v| v.iter().copied()).collect();
         let mut w = vec![0.0; q * n];
@@ -257,7 +257,7 @@ impl<'m> Integrator<'m> {
             history_try: vec![0.0; ds],
             tangents,
         };
-        Ok(Integrator { model, step, alpha, beta, gamma, c0, c1, damping, solver, dirs, w, c, offsets, q, work })
+        Ok(Integrator { model, step, alpha, beta, gamma, c0, c1, operators, solver, dirs, w, c, offsets, q, work })
     }
 
     pub fn step_size(&self) -> f64 {
@@ -370,8 +370,8 @@ impl<'m> Integrator<'m> {
             );
         }
         let mut tmp = vec![0.0; n];
-        lin.stiffness.mul_vec(&state.displacement, &mut state.ku);
-        self.damping.apply(lin, &state.velocity, &mut state.dv, &mut tmp);
+        self.operators.stiffness.apply(&state.displacement, &mut state.ku);
+        self.operators.damp(&state.velocity, &mut state.dv, &mut tmp);
         let mut rhs: Vec<f64> = (0..n).map(|i| excitation * load[i] - state.ku[i] - state.dv[i]).collect();
         for a in 0..self.q {
             axpy(-state.element_force[a], &self.dirs[a * n..(a + 1) * n], &mut rhs);
@@ -405,11 +405,11 @@ impl<'m> Integrator<'m> {
             wk.v_pred[i] = v + h * (1.0 - gamma) * a;
             wk.x[i] = c0 * wk.u_pred[i];
         }
-        lin.mass.mul_vec(&wk.x, &mut wk.rhs);
+        self.operators.mass.apply(&wk.x, &mut wk.rhs);
         for i in 0..n {
             wk.x[i] = ap * (c1 * wk.u_pred[i] - wk.v_pred[i]);
         }
-        self.damping.apply(lin, &wk.x, &mut wk.y, &mut wk.tmp);
+        self.operators.damp(&wk.x, &mut wk.y, &mut wk.tmp);
         for i in 0..n {
             wk.rhs[i] += wk.y[i] + alpha * (state.dv[i] + state.ku[i]) + excitation_eval * load[i];
         }
@@ -486,7 +486,7 @@ impl<'m> Integrator<'m> {
         if wk.u_new.iter().any(|x| !x.is_finite()) {
             return Err(TimesimError::Diverged { time: state.time + h });
         }
-        self.damping.apply(lin, &wk.v_new, &mut wk.dv_new, &mut wk.tmp);
+        self.operators.damp(&wk.v_new, &mut wk.dv_new, &mut wk.tmp);
 
         // Energy tally (before the state is overwritten).
         let e_mid = 0.5 * (state.excitation + excitation_end);
@@ -519,7 +519,7 @@ impl<'m> Integrator<'m> {
         state.acceleration.copy_from_slice(&wk.a_new);
         std::mem::swap(&mut state.dv, &mut wk.dv_new);
         if alpha != 0.0 {
-            lin.stiffness.mul_vec(&state.displacement, &mut state.ku);
+            self.operators.stiffness.apply(&state.displacement, &mut state.ku);
         }
         state.excitation = excitation_end;
         state.time += h;

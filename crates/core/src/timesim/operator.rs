@@ -15,44 +15,111 @@ use crate::model::{Damping, LinearModel, Matrix};
 /// matrix-vector product (faster than two triangular solves at these sizes, and allocation-free).
 const SPARSE_ABOVE: usize = 400;
 
-/// `D x` without forming D when it is Rayleigh (sparse models stay sparse).
+/// A matrix of the linear part as the step applies it: dense column-major (contiguous
+/// columns, so that `y = A x` is a sequence of axpys), or the model's sparse matrix.
 #[derive(Debug)]
-pub(crate) enum DampingOperator {
-    None,
-    Matrix(Matrix),
-    Rayleigh { alpha: f64, beta: f64 },
+pub(crate) enum Operator {
+    Dense { n: usize, values: Vec<f64> },
+    Sparse(Matrix),
 }
 
-impl DampingOperator {
-    /// Modal damping is a dense `M Φ diag(2ζω) Φᵀ M` built from all modes (DESIGN: time
-    /// integration of reduced models, where all modes are cheap).
-    pub(crate) fn new(model: &LinearModel) -> Result<Self, TimesimError> {
-        Ok(match &model.damping {
-            Damping::None => DampingOperator::None,
-            Damping::Matrix(d) => DampingOperator::Matrix(d.clone()),
-            Damping::Rayleigh { alpha, beta } => DampingOperator::Rayleigh { alpha: *alpha, beta: *beta },
-            Damping::Modal { .. } => {
-                let modes = model.dense_modes()?;
-                DampingOperator::Matrix(Matrix::Dense(model.damping_dense(Some(&modes))))
+impl Operator {
+    pub(crate) fn new(m: &Matrix) -> Self {
+        match m {
+            Matrix::Dense(d) => Operator::from_dense(d),
+            Matrix::Sparse(_) => Operator::Sparse(m.clone()),
+        }
+    }
+
+    fn from_dense(d: &Mat<f64>) -> Self {
+        let n = d.nrows();
+        let mut values = Vec::with_capacity(n * d.ncols());
+        for j in 0..d.ncols() {
+            values.extend_from_slice(d.col_as_slice(j));
+        }
+        Operator::Dense { n, values }
+    }
+
+    /// `y = A x`.
+    pub(crate) fn apply(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            Operator::Dense { n, values } => {
+                y.iter_mut().for_each(|v| *v = 0.0);
+                for (col, &xj) in values.chunks_exact(*n).zip(x) {
+                    if xj != 0.0 {
+                        y.iter_mut().zip(col).for_each(|(yi, a)| *yi += a * xj);
+                    }
+                }
             }
+            Operator::Sparse(m) => m.mul_vec(x, y),
+        }
+    }
+}
+
+/// The linear part of the model as operators: `M x`, `K x`, `D x`.
+#[derive(Debug)]
+pub(crate) struct LinearOperators {
+    pub(crate) mass: Operator,
+    pub(crate) stiffness: Operator,
+    pub(crate) damping: DampingOperator,
+}
+
+impl LinearOperators {
+    pub(crate) fn new(model: &LinearModel) -> Result<Self, TimesimError> {
+        Ok(LinearOperators {
+            mass: Operator::new(&model.mass),
+            stiffness: Operator::new(&model.stiffness),
+            damping: DampingOperator::new(model)?,
         })
     }
 
     /// `y = D x`; `tmp` is a scratch vector of the model's length.
-    pub(crate) fn apply(&self, model: &LinearModel, x: &[f64], y: &mut [f64], tmp: &mut [f64]) {
-        match self {
+    pub(crate) fn damp(&self, x: &[f64], y: &mut [f64], tmp: &mut [f64]) {
+        match &self.damping {
             DampingOperator::None => y.iter_mut().for_each(|v| *v = 0.0),
-            DampingOperator::Matrix(d) => d.mul_vec(x, y),
+            DampingOperator::Matrix(d) => d.apply(x, y),
             DampingOperator::Rayleigh { alpha, beta } => {
-                model.mass.mul_vec(x, y);
-                model.stiffness.mul_vec(x, tmp);
+                self.mass.apply(x, y);
+                self.stiffness.apply(x, tmp);
                 y.iter_mut().zip(tmp.iter()).for_each(|(a, b)| *a = alpha * *a + beta * b);
             }
         }
     }
+}
+
+/// `D x` without forming D when it is Rayleigh (sparse models stay sparse).
+#[derive(Debug)]
+pub(crate) enum DampingOperator {
+    None,
+    Matrix(Operator),
+    Rayleigh { alpha: f64, beta: f64 },
+}
+
+impl DampingOperator {
+    /// Modal damping is a dense `M Φ diag(2ζω) Φᵀ M` built from all modes (meant for reduced
+    /// models, where all modes are cheap); dense Rayleigh damping is formed once.
+    fn new(model: &LinearModel) -> Result<Self, TimesimError> {
+        let n = model.n_dofs();
+        Ok(match &model.damping {
+            Damping::None => DampingOperator::None,
+            Damping::Matrix(d) => DampingOperator::Matrix(Operator::new(d)),
+            Damping::Rayleigh { alpha, beta } => match (&model.mass, &model.stiffness) {
+                (Matrix::Dense(m), Matrix::Dense(k)) => {
+                    DampingOperator::Matrix(Operator::from_dense(&Mat::from_fn(n, n, |i, j| {
+                        alpha * m[(i, j)] + beta * k[(i, j)]
+                    })))
+                }
+                _ => DampingOperator::Rayleigh { alpha: *alpha, beta: *beta },
+            },
+            Damping::Modal { .. } => {
+                let modes = model.dense_modes()?;
+                DampingOperator::Matrix(Operator::from_dense(&model.damping_dense(Some(&modes))))
+            }
+        })
+    }
 
     fn is_sparse(&self) -> bool {
-        !matches!(self, DampingOperator::Matrix(Matrix::Dense(_)))
+        !matches!(self, DampingOperator::Matrix(Operator::Dense { .. }))
     }
 
     /// Dense D.
@@ -60,7 +127,8 @@ impl DampingOperator {
         let n = model.n_dofs();
         match self {
             DampingOperator::None => Mat::zeros(n, n),
-            DampingOperator::Matrix(d) => d.to_dense(),
+            DampingOperator::Matrix(Operator::Dense { values, .. }) => Mat::from_fn(n, n, |i, j| values[j * n + i]),
+            DampingOperator::Matrix(Operator::Sparse(d)) => d.to_dense(),
             DampingOperator::Rayleigh { alpha, beta } => {
                 let (m, k) = (model.mass.to_dense(), model.stiffness.to_dense());
                 Mat::from_fn(n, n, |i, j| alpha * m[(i, j)] + beta * k[(i, j)])
@@ -146,12 +214,13 @@ impl SpdSolver {
 /// `S = c_m M + c_d D + c_k K` factorised.
 pub(crate) fn effective_solver(
     model: &LinearModel,
-    damping: &DampingOperator,
+    operators: &LinearOperators,
     c_m: f64,
     c_d: f64,
     c_k: f64,
 ) -> Result<SpdSolver, TimesimError> {
     let n = model.n_dofs();
+    let damping = &operators.damping;
     let solver = if damping.is_sparse() {
         // Rayleigh damping folds into the M and K coefficients.
         let (mut cm, mut ck) = (c_m, c_k);
@@ -161,7 +230,8 @@ pub(crate) fn effective_solver(
                 cm += c_d * alpha;
                 ck += c_d * beta;
             }
-            DampingOperator::Matrix(d) => terms.push((c_d, d)),
+            DampingOperator::Matrix(Operator::Sparse(d)) => terms.push((c_d, d)),
+            DampingOperator::Matrix(Operator::Dense { .. }) => unreachable!("dense damping takes the dense path"),
             DampingOperator::None => {}
         }
         terms.push((cm, &model.mass));
