@@ -1,0 +1,259 @@
+//! Thick-restart Lanczos (Wu & Simon, SIAM J. Matrix Anal. Appl. 22, 2000) for the
+//! shift-invert operator `OP = (K − σM)⁻¹ M`, self-adjoint in the M inner product. Its largest
+//! eigenvalues θ = 1/(λ − σ) are the eigenvalues λ = ω² nearest σ.
+//!
+//! Both `V` and `MV` are kept, so every step costs one solve and two products with M; the
+//! basis is fully reorthogonalised (twice, which is enough in floating point) because the
+//! Krylov spaces here are small (tens of vectors) next to the cost of a solve.
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::matmul::sparse_dense_matmul;
+use faer::sparse::SparseColMat;
+use faer::{Accum, Mat, MatRef, Par, Side};
+use stickslip_core::model::Modes;
+
+use super::{default_shift, EigenError, EigenOptions, EigenSolution, ShiftedFactor};
+
+/// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default).
+pub fn solve(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    check_sizes(k, m)?;
+    let shift = opts.shift.unwrap_or_else(|| default_shift(k, m));
+    let factor = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), shift)?;
+    modes_with_factor(k, m, &factor, opts)
+}
+
+fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Result<(), EigenError> {
+    if k.nrows() != k.ncols() || m.nrows() != m.ncols() || k.nrows() != m.nrows() {
+        return Err(EigenError::Size { k_rows: k.nrows(), k_cols: k.ncols(), m_rows: m.nrows(), m_cols: m.ncols() });
+    }
+    Ok(())
+}
+
+/// As [`solve`], with an existing factorisation of `K − σM` (its shift is used).
+pub fn modes_with_factor(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    factor: &ShiftedFactor,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    check_sizes(k, m)?;
+    let n = k.nrows();
+    let nev = opts.count;
+    if nev == 0 || nev > n {
+        return Err(EigenError::TooManyModes { requested: nev, available: n });
+    }
+    let sigma = factor.shift();
+    let ncv = opts.subspace.unwrap_or((2 * nev + 20).max(nev + 30)).clamp(nev + 1, n.max(nev + 1));
+    // A full-size space needs no Lanczos: fall back on ncv = n with one cycle.
+    let ncv = ncv.min(n);
+    let par = Par::rayon(0);
+    let mut v = Mat::<f64>::zeros(n, ncv + 1);
+    let mut mv = Mat::<f64>::zeros(n, ncv + 1);
+    let mut h = Mat::<f64>::zeros(ncv + 1, ncv);
+    let mut coef = Mat::<f64>::zeros(ncv + 1, 1);
+    let mut solves = 0;
+
+    // Start: OP applied to a deterministic pseudo-random vector puts it in the range of OP.
+    {
+        let mut x = Mat::<f64>::from_fn(n, 1, |i, _| pseudo_random(i));
+        let mut mx = Mat::<f64>::zeros(n, 1);
+        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        factor.solve_in_place(mx.as_mut());
+        solves += 1;
+        x.copy_from(&mx);
+        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        let norm = dot(x.as_ref(), mx.as_ref()).sqrt();
+        v.col_mut(0).copy_from(x.col(0) / norm);
+        mv.col_mut(0).copy_from(mx.col(0) / norm);
+    }
+
+    let mut start = 0;
+    let mut restarts = 0;
+    loop {
+        for j in start..ncv {
+            // w = OP v_j = (K − σM)⁻¹ (M v_j); z = M w.
+            let (done, mut next) = v.as_mut().split_at_col_mut(j + 1);
+            let mut w = next.rb_mut().subcols_mut(0, 1);
+            w.copy_from(mv.col(j).as_mat());
+            factor.solve_in_place(w.rb_mut());
+            solves += 1;
+            let (mdone, mut mnext) = mv.as_mut().split_at_col_mut(j + 1);
+            let mut z = mnext.rb_mut().subcols_mut(0, 1);
+            sparse_dense_matmul(z.rb_mut(), Accum::Replace, m.as_ref(), w.rb(), 1.0, par);
+            // Two passes of classical Gram-Schmidt in the M inner product.
+            for _ in 0..2 {
+                let mut c = coef.as_mut().subrows_mut(0, j + 1);
+                matmul(c.rb_mut(), Accum::Replace, done.rb().transpose(), z.rb(), 1.0, par);
+                matmul(w.rb_mut(), Accum::Add, done.rb(), c.rb(), -1.0, par);
+                matmul(z.rb_mut(), Accum::Add, mdone.rb(), c.rb(), -1.0, par);
+                for i in 0..=j {
+                    h[(i, j)] += c[(i, 0)];
+                }
+            }
+            // M w afresh: after cancellation the updated z is not accurate enough to
+            // normalise with when β is small (near-invariant subspaces, clustered modes).
+            sparse_dense_matmul(z.rb_mut(), Accum::Replace, m.as_ref(), w.rb(), 1.0, par);
+            let beta = dot(w.rb(), z.rb()).max(0.0).sqrt();
+            h[(j + 1, j)] = beta;
+            let scale = h[(j, j)].abs().max(f64::MIN_POSITIVE);
+            if beta <= 1e-14 * scale {
+                // Invariant subspace: continue with a fresh direction orthogonal to the basis.
+                restart_direction(m, &mut v, &mut mv, j + 1, par);
+                h[(j + 1, j)] = 0.0;
+            } else {
+                let (mut w, mut z) = (w, z);
+                w.copy_from(w.rb() / beta);
+                z.copy_from(z.rb() / beta);
+            }
+        }
+
+        // Rayleigh-Ritz on the projected operator (symmetric up to round-off).
+        let s = Mat::<f64>::from_fn(ncv, ncv, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
+        let evd = s
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|_| EigenError::Factorisation("the projected eigenproblem did not converge".into()))?;
+        // Largest |θ| first: the eigenvalues nearest the shift.
+        let mut order: Vec<usize> = (0..ncv).collect();
+        order.sort_by(|&a, &b| evd.S()[b].abs().total_cmp(&evd.S()[a].abs()));
+        let beta_m = h[(ncv, ncv - 1)];
+        let residual = |i: usize| (beta_m * evd.U()[(ncv - 1, i)]).abs() / evd.S()[i].abs().max(f64::MIN_POSITIVE);
+        let converged = order[..nev].iter().filter(|&&i| residual(i) <= opts.tolerance).count();
+        if converged == nev || ncv == n {
+            return finish(
+                k,
+                m,
+                v.as_ref(),
+                evd.U(),
+                &evd.S().column_vector().iter().copied().collect::<Vec<_>>(),
+                &order[..nev],
+                sigma,
+                factor,
+                solves,
+                restarts,
+                opts,
+            );
+        }
+        if restarts == opts.max_restarts {
+            let worst = order[..nev].iter().map(|&i| residual(i)).fold(0.0, f64::max);
+            return Err(EigenError::NotConverged { restarts, converged, requested: nev, worst });
+        }
+        // Thick restart: keep the best Ritz vectors, the residual direction follows them.
+        restarts += 1;
+        let keep = (nev + (ncv - nev) / 2).min(ncv - 1);
+        let y = Mat::<f64>::from_fn(ncv, keep, |i, c| evd.U()[(i, order[c])]);
+        let new_v = v.subcols(0, ncv) * &y;
+        let new_mv = mv.subcols(0, ncv) * &y;
+        let last = v.col(ncv).to_owned();
+        let mlast = mv.col(ncv).to_owned();
+        v.subcols_mut(0, keep).copy_from(&new_v);
+        mv.subcols_mut(0, keep).copy_from(&new_mv);
+        v.col_mut(keep).copy_from(&last);
+        mv.col_mut(keep).copy_from(&mlast);
+        h.fill(0.0);
+        for c in 0..keep {
+            let i = order[c];
+            h[(c, c)] = evd.S()[i];
+            h[(keep, c)] = beta_m * evd.U()[(ncv - 1, i)];
+        }
+        start = keep;
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    v: MatRef<'_, f64>,
+    y: MatRef<'_, f64>,
+    theta: &[f64],
+    wanted: &[usize],
+    sigma: f64,
+    factor: &ShiftedFactor,
+    solves: usize,
+    restarts: usize,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    let n = v.nrows();
+    let ncv = y.nrows();
+    let par = Par::rayon(0);
+    let mut pairs: Vec<(f64, usize)> = wanted.iter().map(|&i| (sigma + 1.0 / theta[i], i)).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let ysel = Mat::<f64>::from_fn(ncv, pairs.len(), |r, c| y[(r, pairs[c].1)]);
+    let mut shapes = v.subcols(0, ncv) * &ysel;
+    let mut kx = Mat::<f64>::zeros(n, pairs.len());
+    let mut mx = Mat::<f64>::zeros(n, pairs.len());
+    sparse_dense_matmul(kx.as_mut(), Accum::Replace, k.as_ref(), shapes.as_ref(), 1.0, par);
+    sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), shapes.as_ref(), 1.0, par);
+    let mut omega = Vec::with_capacity(pairs.len());
+    let mut residuals = Vec::with_capacity(pairs.len());
+    for (c, &(_, _)) in pairs.iter().enumerate() {
+        // Mass-normalise and take the Rayleigh quotient, more accurate than σ + 1/θ.
+        let mass = dot(shapes.col(c).as_mat(), mx.col(c).as_mat());
+        let s = 1.0 / mass.sqrt();
+        let lambda = dot(shapes.col(c).as_mat(), kx.col(c).as_mat()) / mass;
+        let mut r2 = 0.0;
+        let mut k2 = 0.0;
+        let mut m2 = 0.0;
+        for i in 0..n {
+            let (kv, mv) = (kx[(i, c)] * s, mx[(i, c)] * s);
+            r2 += (kv - lambda * mv).powi(2);
+            k2 += kv * kv;
+            m2 += mv * mv;
+        }
+        let denom = k2.sqrt().max(sigma.abs() * m2.sqrt()).max(f64::MIN_POSITIVE);
+        let res = r2.sqrt() / denom;
+        if res > opts.residual_limit {
+            return Err(EigenError::Inaccurate { mode: c + 1, residual: res, tolerance: opts.residual_limit });
+        }
+        shapes.col_mut(c).iter_mut().for_each(|x| *x *= s);
+        // Rigid-body modes come out at |λ| ~ round-off: report them as 0 rad/s.
+        omega.push(lambda.max(0.0).sqrt());
+        residuals.push(res);
+    }
+    Ok(EigenSolution {
+        modes: Modes { omega, shapes },
+        residuals,
+        shift: sigma,
+        below_shift: factor.eigenvalues_below_shift(),
+        solves,
+        restarts,
+    })
+}
+
+/// Replace column `j` of `v` by a new M-normalised vector M-orthogonal to columns `0..j`.
+fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Mat<f64>, j: usize, par: Par) {
+    let n = v.nrows();
+    for attempt in 0..8 {
+        let mut x = Mat::<f64>::from_fn(n, 1, |i, _| pseudo_random(i + (attempt + 1) * (j + 7) * 7919));
+        let mut mx = Mat::<f64>::zeros(n, 1);
+        for _ in 0..2 {
+            sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+            let c = v.subcols(0, j).transpose() * &mx;
+            x -= v.subcols(0, j) * &c;
+        }
+        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        let norm = dot(x.as_ref(), mx.as_ref()).max(0.0).sqrt();
+        if norm > 1e-8 {
+            v.col_mut(j).copy_from(x.col(0) / norm);
+            mv.col_mut(j).copy_from(mx.col(0) / norm);
+            return;
+        }
+    }
+}
+
+fn dot(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
+    (0..a.nrows()).map(|i| a[(i, 0)] * b[(i, 0)]).sum()
+}
+
+/// Deterministic values in (-0.5, 0.5) (SplitMix64), so runs are reproducible.
+fn pseudo_random(i: usize) -> f64 {
+    let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}

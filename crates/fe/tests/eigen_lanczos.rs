@@ -1,0 +1,125 @@
+//! Sparse shift-invert Lanczos against closed forms and the dense solver.
+mod eigen_models;
+
+use eigen_models::*;
+use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix};
+use stickslip_fe::eigen::{self, EigenError, EigenOptions, ShiftedFactor};
+
+fn opts(count: usize) -> EigenOptions {
+    EigenOptions { count, ..Default::default() }
+}
+
+#[test]
+fn grounded_chain_matches_closed_form() {
+    let (n, k, m) = (400, 2.0e5, 0.3);
+    let (ks, ms) = chain(n, k, m, true);
+    let sol = eigen::solve(&ks, &ms, &opts(12)).unwrap();
+    let exact = chain_fixed_free_omega2(n, k, m);
+    for (r, w) in sol.modes.omega.iter().enumerate() {
+        // Closed form in exact arithmetic; the solver converges to ~1e-14 relative, the
+        // closed form itself is evaluated to ~1e-15: 1e-10 leaves a wide margin.
+        assert!((w * w / exact[r] - 1.0).abs() < 1e-10, "mode {r}: {} vs {}", w * w, exact[r]);
+    }
+    assert!(sol.residuals.iter().all(|r| *r < 1e-8), "{:?}", sol.residuals);
+    assert_eq!(sol.below_shift, 0);
+    // Mass-normalised: φᵀ M φ = 1 and M-orthogonal, to round-off.
+    let phi = &sol.modes.shapes;
+    let mphi = Matrix::Sparse(ms.clone()).to_dense() * phi;
+    let g = phi.transpose() * &mphi;
+    for i in 0..g.nrows() {
+        for j in 0..g.ncols() {
+            let e = if i == j { 1.0 } else { 0.0 };
+            assert!((g[(i, j)] - e).abs() < 1e-10, "Φᵀ M Φ ({i},{j}) = {}", g[(i, j)]);
+        }
+    }
+}
+
+#[test]
+fn laplacian_2d_with_consistent_mass_matches_closed_form() {
+    let (k, m, exact) = laplacian_2d(30, 23);
+    let sol = eigen::solve(&k, &m, &opts(20)).unwrap();
+    for (r, w) in sol.modes.omega.iter().enumerate() {
+        // Separate eigenvalues of an exactly known discrete problem: 1e-10 relative.
+        assert!((w * w / exact[r] - 1.0).abs() < 1e-10, "mode {r}: {} vs {}", w * w, exact[r]);
+    }
+}
+
+#[test]
+fn free_free_chain_has_a_rigid_mode_at_zero() {
+    let (n, k, m) = (200, 1.0e4, 0.5);
+    let (ks, ms) = chain(n, k, m, false);
+    let sol = eigen::solve(&ks, &ms, &opts(4)).unwrap();
+    // The rigid-body mode: ω = 0 up to round-off of the eigenvalue (ω² ~ 1e-16 k/m).
+    assert!(sol.modes.omega[0] < 1e-5 * (k / m).sqrt(), "{}", sol.modes.omega[0]);
+    // Free-free chain: ω_r = 2 √(k/m) sin(rπ / (2n)).
+    for r in 1..4 {
+        let exact = 2.0 * (k / m).sqrt() * (r as f64 * std::f64::consts::PI / (2.0 * n as f64)).sin();
+        assert!((sol.modes.omega[r] / exact - 1.0).abs() < 1e-10, "mode {r}");
+    }
+    // Its shape is uniform, mass-normalised: φ_i = 1/√(n m).
+    let phi0 = sol.modes.shapes.col(0);
+    for i in 0..n {
+        assert!((phi0[i].abs() - 1.0 / (n as f64 * m).sqrt()).abs() < 1e-8);
+    }
+}
+
+#[test]
+fn matches_dense_solver_on_a_small_3d_lattice() {
+    let (k, m) = lattice_3d(4, 3, 5, 5.0e5);
+    let n = k.nrows();
+    let dofs = (0..n).map(|i| DofLabel::nodal((i / 3) as u64 + 1, (i % 3) as u8 + 1)).collect();
+    let model =
+        LinearModel::new(Matrix::Sparse(m.clone()), Matrix::Sparse(k.clone()), Damping::None, dofs, vec![]).unwrap();
+    let dense = model.dense_modes().unwrap();
+    let sol = eigen::solve(&k, &m, &opts(25)).unwrap();
+    for r in 0..25 {
+        // Two independent double-precision solvers of a well-conditioned problem: 1e-10.
+        let rel = (sol.modes.omega[r] / dense.omega[r] - 1.0).abs();
+        assert!(rel < 1e-10, "mode {r}: {} vs {} ({rel:.1e})", sol.modes.omega[r], dense.omega[r]);
+        // Same shapes up to sign: |φ_sparseᵀ M φ_dense| = 1.
+        let md = Matrix::Sparse(m.clone());
+        let a: Vec<f64> = (0..n).map(|i| sol.modes.shapes[(i, r)]).collect();
+        let b: Vec<f64> = (0..n).map(|i| dense.shapes[(i, r)]).collect();
+        assert!((md.bilinear(&a, &b).abs() - 1.0).abs() < 1e-8, "shape {r}");
+    }
+}
+
+#[test]
+fn interior_shift_finds_the_nearest_modes_and_counts_those_below() {
+    let (n, k, m) = (300, 2.0e5, 0.3);
+    let (ks, ms) = chain(n, k, m, true);
+    let exact = chain_fixed_free_omega2(n, k, m);
+    // Shift between modes 40 and 41 (0-based 39 and 40).
+    let sigma = 0.5 * (exact[39] + exact[40]);
+    let sol = eigen::solve(&ks, &ms, &EigenOptions { count: 6, shift: Some(sigma), ..Default::default() }).unwrap();
+    // Sylvester's inertia: exactly 40 eigenvalues below σ.
+    assert_eq!(sol.below_shift, 40);
+    let got: Vec<f64> = sol.modes.omega.iter().map(|w| w * w).collect();
+    for (g, e) in got.iter().zip(&exact[37..43]) {
+        assert!((g / e - 1.0).abs() < 1e-10, "{g} vs {e}");
+    }
+}
+
+#[test]
+fn mechanism_at_zero_shift_is_a_clear_error() {
+    let (ks, ms) = chain(50, 1.0e4, 0.5, false);
+    let err = eigen::solve(&ks, &ms, &EigenOptions { count: 3, shift: Some(0.0), ..Default::default() }).unwrap_err();
+    assert!(matches!(err, EigenError::Singular { .. }), "{err}");
+    assert!(err.to_string().contains("mechanism"), "{err}");
+    // A shift exactly on an eigenvalue is singular too.
+    let (ks, ms) = chain(3, 1.0, 1.0, true);
+    let exact = chain_fixed_free_omega2(3, 1.0, 1.0);
+    assert!(matches!(ShiftedFactor::new(ks.as_ref(), Some(ms.as_ref()), exact[1]), Err(EigenError::Singular { .. })));
+}
+
+#[test]
+fn too_many_modes_is_an_error() {
+    let (ks, ms) = chain(5, 1.0, 1.0, true);
+    assert!(matches!(eigen::solve(&ks, &ms, &opts(6)), Err(EigenError::TooManyModes { .. })));
+    // All of them is fine (the Krylov space is the whole space).
+    let sol = eigen::solve(&ks, &ms, &opts(5)).unwrap();
+    let exact = chain_fixed_free_omega2(5, 1.0, 1.0);
+    for r in 0..5 {
+        assert!((sol.modes.omega[r].powi(2) / exact[r] - 1.0).abs() < 1e-10);
+    }
+}
