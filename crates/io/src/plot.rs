@@ -1,1 +1,246 @@
-//! Plots of results (plotters): FRFs of all levels, harmonics, hysteresis loops.
+//! Plots of results with plotters, as PNG or SVG (chosen by the file extension):
+//! - [`plot_frf`]: FRF amplitude (log scale) against frequency in Hz, one curve per force level;
+//! - [`plot_harmonics`]: amplitude of harmonics 1..N against frequency for one level (the paper's
+//!   Fig. 21 view of where odd harmonics rise);
+//! - [`plot_hysteresis`]: force against displacement of one element over a period;
+//! - [`plot_slider_velocity`]: slider velocity v_P over a period (paper Eq. 33, Fig. 17).
+//!
+//! SVG keeps text as text and needs no font; PNG rasterises labels with a system font found
+//! through fontconfig (on Debian, the package fonts-dejavu-core provides one).
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::prelude::*;
+
+use crate::output::{LevelResult, OutputError, PointRecord};
+use crate::study::PlotFormat;
+
+const SIZE: (u32, u32) = (1000, 650);
+const FONT: &str = "sans-serif";
+
+/// One curve: a label and its points.
+struct Curve {
+    label: String,
+    points: Vec<(f64, f64)>,
+}
+
+/// A chart of curves, linear x, linear or log y.
+struct Chart {
+    title: String,
+    x_label: String,
+    y_label: String,
+    log_y: bool,
+    curves: Vec<Curve>,
+}
+
+impl Chart {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+        let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        // Log axes only take positive values: zeros (e.g. a harmonic that vanishes by symmetry)
+        // are left out rather than drawn at an arbitrary floor.
+        let keep = |&(_, y): &(f64, f64)| y.is_finite() && (!self.log_y || y > 0.0);
+        let all: Vec<(f64, f64)> = self.curves.iter().flat_map(|c| c.points.iter().copied().filter(keep)).collect();
+        if all.is_empty() {
+            return Err(format!(
+                "{}: nothing to plot (no finite{} values)",
+                self.title,
+                if self.log_y { " positive" } else { "" }
+            ));
+        }
+        let (mut x0, mut x1) = min_max(all.iter().map(|p| p.0));
+        let (mut y0, mut y1) = min_max(all.iter().map(|p| p.1));
+        if x1 <= x0 {
+            (x0, x1) = (x0 - 0.5 * x0.abs().max(1.0), x1 + 0.5 * x1.abs().max(1.0));
+        }
+        let mut chart = ChartBuilder::on(&root);
+        chart.caption(&self.title, (FONT, 22)).margin(15).x_label_area_size(45).y_label_area_size(85);
+        if self.log_y {
+            (y0, y1) = (y0 / 1.5, y1 * 1.5);
+            let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc(&self.x_label)
+                .y_desc(&self.y_label)
+                .y_label_formatter(&|y| format!("{y:.0e}"))
+                .label_style((FONT, 15))
+                .draw()
+                .map_err(e)?;
+            self.draw_curves(&mut chart, keep).map_err(e)?;
+        } else {
+            let pad = 0.05 * (y1 - y0).max(1e-3 * y0.abs().max(y1.abs())).max(f64::MIN_POSITIVE);
+            (y0, y1) = (y0 - pad, y1 + pad);
+            let mut chart = chart.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc(&self.x_label)
+                .y_desc(&self.y_label)
+                .x_label_formatter(&|x| tick(*x))
+                .y_label_formatter(&|y| tick(*y))
+                .label_style((FONT, 15))
+                .draw()
+                .map_err(e)?;
+            self.draw_curves(&mut chart, keep).map_err(e)?;
+        }
+        root.present().map_err(e)
+    }
+
+    /// The curves, one colour each, and their legend.
+    fn draw_curves<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
+        &self,
+        chart: &mut ChartContext<'a, DB, CT>,
+        keep: impl Fn(&(f64, f64)) -> bool + Copy,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        for (i, c) in self.curves.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            chart
+                .draw_series(LineSeries::new(c.points.iter().copied().filter(keep), color.stroke_width(2)))?
+                .label(c.label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 15))
+            .draw()
+    }
+
+    /// Render to `path`, PNG or SVG by its extension.
+    fn render(&self, path: &Path) -> Result<(), OutputError> {
+        let plot_error = |m: String| {
+            let hint = if m.contains("Font loading error") {
+                " (PNG labels need a system font: install one, e.g. the Debian package fonts-dejavu-core, or write SVG with plot_format = \"svg\")"
+            } else {
+                ""
+            };
+            OutputError::Plot(format!("{}: {m}{hint}", path.display()))
+        };
+        match path.extension().and_then(|x| x.to_str()) {
+            Some("svg") => self.draw(SVGBackend::new(path, SIZE).into_drawing_area()).map_err(plot_error),
+            Some("png") => self.draw(BitMapBackend::new(path, SIZE).into_drawing_area()).map_err(plot_error),
+            _ => Err(plot_error("the plot file name must end in .png or .svg".into())),
+        }
+    }
+}
+
+/// A tick label: plain decimals for moderate magnitudes, exponent form otherwise.
+fn tick(v: f64) -> String {
+    if v == 0.0 || (1e-2..1e5).contains(&v.abs()) {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
+}
+
+fn output_index(p: &PointRecord, output: &str) -> Result<usize, OutputError> {
+    p.outputs.iter().position(|o| o.name == output).ok_or_else(|| {
+        let known: Vec<&str> = p.outputs.iter().map(|o| o.name.as_str()).collect();
+        OutputError::Plot(format!("no output named {output:?} (outputs are: {})", known.join(", ")))
+    })
+}
+
+fn element_index(p: &PointRecord, element: &str) -> Result<usize, OutputError> {
+    p.elements.iter().position(|e| e.name == element).ok_or_else(|| {
+        let known: Vec<&str> = p.elements.iter().map(|e| e.name.as_str()).collect();
+        OutputError::Plot(format!("no element named {element:?} (elements are: {})", known.join(", ")))
+    })
+}
+
+/// Displacement FRF |X₁|/F (m/N, log scale) of `output` against frequency (Hz), one curve per level.
+pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(), OutputError> {
+    let mut curves = Vec::with_capacity(levels.len());
+    for l in levels {
+        let points = match l.points.first() {
+            Some(p0) => {
+                let o = output_index(p0, output)?;
+                l.points.iter().map(|p| (p.frequency_hz, p.outputs[o].disp_frf)).collect()
+            }
+            None => Vec::new(),
+        };
+        curves.push(Curve { label: format!("{} N", l.level_n), points });
+    }
+    Chart {
+        title: format!("FRF of {output}"),
+        x_label: "Frequency (Hz)".into(),
+        y_label: "Displacement / force (m/N)".into(),
+        log_y: true,
+        curves,
+    }
+    .render(path)
+}
+
+/// One FRF plot per output, `dir/frf_<output>.<png|svg>`; returns the files written.
+pub fn plot_frfs(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(Vec::new()) };
+    let mut files = Vec::new();
+    for o in &first.outputs {
+        let path = dir.join(format!("frf_{}.{}", o.name, format.extension()));
+        plot_frf(&path, levels, &o.name)?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// Amplitudes of harmonics 1..N (m, log scale) of `output` against frequency (Hz) for one level.
+pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<(), OutputError> {
+    let Some(p0) = level.points.first() else {
+        return Err(OutputError::Plot(format!("level {} N has no points to plot", level.level_n)));
+    };
+    let o = output_index(p0, output)?;
+    let n = p0.outputs[o].harmonics.len().saturating_sub(1);
+    let curves = (1..=n)
+        .map(|k| Curve {
+            label: format!("harmonic {k}"),
+            points: level.points.iter().map(|p| (p.frequency_hz, p.outputs[o].harmonics[k].0)).collect(),
+        })
+        .collect();
+    Chart {
+        title: format!("Harmonics of {output} at {} N", level.level_n),
+        x_label: "Frequency (Hz)".into(),
+        y_label: "Amplitude (m)".into(),
+        log_y: true,
+        curves,
+    }
+    .render(path)
+}
+
+/// Hysteresis loop of `element` at one point: force (N) against displacement (m), closed.
+pub fn plot_hysteresis(path: &Path, point: &PointRecord, element: &str) -> Result<(), OutputError> {
+    let e = &point.elements[element_index(point, element)?];
+    let mut points: Vec<(f64, f64)> = e.loop_u.iter().copied().zip(e.loop_force.iter().copied()).collect();
+    if let Some(&p) = points.first() {
+        points.push(p);
+    }
+    Chart {
+        title: format!("Hysteresis of {element} at {:.4} Hz", point.frequency_hz),
+        x_label: "Displacement (m)".into(),
+        y_label: "Force (N)".into(),
+        log_y: false,
+        curves: vec![Curve { label: element.into(), points }],
+    }
+    .render(path)
+}
+
+/// Slider velocity v_P (m/s, Eq. 33) of `element` over one period against time (ms).
+pub fn plot_slider_velocity(path: &Path, point: &PointRecord, element: &str) -> Result<(), OutputError> {
+    let e = &point.elements[element_index(point, element)?];
+    let n_t = e.slider_velocity.len();
+    let period_ms = 1e3 / point.frequency_hz;
+    let points = e.slider_velocity.iter().enumerate().map(|(j, &v)| (period_ms * j as f64 / n_t as f64, v)).collect();
+    Chart {
+        title: format!("Slider velocity of {element} at {:.4} Hz", point.frequency_hz),
+        x_label: "Time (ms)".into(),
+        y_label: "Velocity (m/s)".into(),
+        log_y: false,
+        curves: vec![Curve { label: element.into(), points }],
+    }
+    .render(path)
+}

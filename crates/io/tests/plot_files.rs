@@ -1,0 +1,133 @@
+//! Plots are written as non-empty PNG and SVG files with their legends.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use stickslip_core::elements::{Element, Jenkins};
+use stickslip_io::output::{ElementRecord, LevelResult, OutputRecord, PointRecord};
+use stickslip_io::plot::{plot_frf, plot_frfs, plot_harmonics, plot_hysteresis, plot_slider_velocity};
+use stickslip_io::study::PlotFormat;
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("stickslip-io-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A linear oscillator's FRF (the shapes the plots must show) with softer, more damped
+/// resonances at higher levels, and a Jenkins loop at one point.
+fn levels() -> Vec<LevelResult> {
+    let n_t = 300;
+    [(100.0, 2.24e7, 0.01), (1000.0, 1.9e7, 0.03), (10000.0, 1.45e7, 0.06)]
+        .iter()
+        .map(|&(level_n, k, zeta)| {
+            let points = (0..=200)
+                .map(|i| {
+                    let f = 150.0 + i as f64;
+                    let w = 2.0 * PI * f;
+                    let wn = (k / 10.0f64).sqrt();
+                    let h = 1.0 / ((k - 10.0 * w * w).powi(2) + (2.0 * zeta * wn * 10.0 * w).powi(2)).sqrt();
+                    let harmonics = (0..=7).map(|k| (h * level_n / (1.0 + k as f64).powi(3), 0.1 * k as f64)).collect();
+                    let (loop_u, loop_force, slider_velocity) = jenkins_loop(h * level_n, w, n_t);
+                    PointRecord {
+                        frequency_hz: f,
+                        iterations: 2,
+                        residual: 1e-10,
+                        outputs: vec![OutputRecord {
+                            name: "mass".into(),
+                            disp_frf: h,
+                            accel_frf: w * w * h,
+                            peak: h * level_n,
+                            harmonics,
+                            ..Default::default()
+                        }],
+                        elements: vec![ElementRecord {
+                            name: "joint".into(),
+                            energy_j: 0.0,
+                            stick_fraction: 1.0,
+                            loop_u,
+                            loop_force,
+                            slider_velocity,
+                        }],
+                    }
+                })
+                .collect();
+            LevelResult { level_n, points }
+        })
+        .collect()
+}
+
+/// Displacement, force and slider velocity of a Jenkins element (k = 8.11e6 N/m, F_c = 1000 N)
+/// under u = a cos θ, second period of the march.
+fn jenkins_loop(a: f64, w: f64, n_t: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let law = Jenkins::new(8.11e6, 1000.0).unwrap();
+    let mut state = [0.0];
+    let (mut u, mut f, mut v) = (Vec::new(), Vec::new(), Vec::new());
+    for period in 0..2 {
+        for j in 0..n_t {
+            let theta = 2.0 * PI * j as f64 / n_t as f64;
+            let before = state[0];
+            let mut g = [0.0];
+            law.update(&[a * theta.cos()], &[0.0], &mut state, &mut g, None);
+            if period == 1 {
+                u.push(a * theta.cos());
+                f.push(g[0]);
+                v.push((state[0] - before) * w * n_t as f64 / (2.0 * PI));
+            }
+        }
+    }
+    (u, f, v)
+}
+
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{} is not a PNG", path.display());
+    // A 1000x650 chart with curves and text compresses to tens of kB; an empty white image
+    // to well under 10 kB.
+    assert!(bytes.len() > 10_000, "{} is only {} bytes", path.display(), bytes.len());
+}
+
+fn svg(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.starts_with("<svg"), "{} is not an SVG", path.display());
+    text
+}
+
+#[test]
+fn frf_plots_have_one_curve_per_level_and_a_legend() {
+    let dir = scratch_dir("plot-frf");
+    let levels = levels();
+    plot_frf(&dir.join("frf.png"), &levels, "mass").unwrap();
+    assert_png(&dir.join("frf.png"));
+    let files = plot_frfs(&dir, &levels, PlotFormat::Svg).unwrap();
+    assert_eq!(files, [dir.join("frf_mass.svg")]);
+    let text = svg(&files[0]);
+    for label in ["100 N", "1000 N", "10000 N", "Frequency (Hz)"] {
+        assert!(text.contains(label), "missing {label:?}");
+    }
+    // Curves and legend marks are the only lines drawn 2 px wide.
+    assert_eq!(text.matches("stroke-width=\"2\"").count(), 3 + 3, "3 curves and 3 legend marks");
+    let msg = plot_frf(&dir.join("frf.png"), &levels, "tip").unwrap_err().to_string();
+    assert_eq!(msg, "no output named \"tip\" (outputs are: mass)");
+    let msg = plot_frf(&dir.join("frf.pdf"), &levels, "mass").unwrap_err().to_string();
+    assert!(msg.ends_with("the plot file name must end in .png or .svg"), "{msg}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn harmonics_hysteresis_and_slider_velocity_plots_are_written() {
+    let dir = scratch_dir("plot-more");
+    let levels = levels();
+    plot_harmonics(&dir.join("harmonics.png"), &levels[2], "mass").unwrap();
+    assert_png(&dir.join("harmonics.png"));
+    plot_harmonics(&dir.join("harmonics.svg"), &levels[2], "mass").unwrap();
+    assert!(svg(&dir.join("harmonics.svg")).contains("harmonic 7"));
+    let point = &levels[2].points[88];
+    plot_hysteresis(&dir.join("loop.png"), point, "joint").unwrap();
+    assert_png(&dir.join("loop.png"));
+    plot_slider_velocity(&dir.join("slider.svg"), point, "joint").unwrap();
+    assert!(svg(&dir.join("slider.svg")).contains("Time (ms)"));
+    if std::env::var_os("STICKSLIP_KEEP_PLOTS").is_none() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
