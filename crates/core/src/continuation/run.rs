@@ -294,9 +294,13 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             // first step is oriented towards λ_end, so going back is a bad correction.
             // A turn that persists after the step was halved four times is a corner of a
             // non-smooth branch (a stick/slip onset makes the curve only C0 there), not a fold
-            // cut too coarsely: halving further would never reduce it.
+            // cut too coarsely: halving further would never reduce it. At a corner of angle α the
+            // corrector lands h·tan α from the prediction, proportional to the step, whereas a
+            // jump to another part of the curve stays far whatever the step: accept corners up
+            // to tan α = 10.
             let corner = control.attempts >= 4;
-            let mut acceptable = distance(&self.z, &self.z_pred) <= control.step
+            let travelled = distance(&self.z, &self.z_pred);
+            let mut acceptable = (travelled <= control.step || (corner && travelled <= 10.0 * control.step))
                 && (self.turn_angle() <= options.max_angle || corner)
                 && !(before_start && points.len() == 1);
 

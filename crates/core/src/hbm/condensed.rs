@@ -170,6 +170,21 @@ impl<'m> CondensedHbm<'m> {
         x
     }
 
+    /// The response with every element linearised about rest (its tangent at zero motion: stuck
+    /// sliders, zero cubic stiffness...): one Newton step from `x = 0`. This is the exact
+    /// solution while every Jenkins/Iwan slider sticks, for elements in the paper's form as well
+    /// as for standalone ones, and the natural start of a sweep.
+    pub fn stuck_solution(&mut self, omega: f64, level: f64) -> Result<Vec<f64>, HbmError> {
+        use faer::linalg::solvers::Solve;
+        let n = self.dimension();
+        let zero = vec![0.0; n];
+        let mut r = vec![0.0; n];
+        let mut jac = Mat::zeros(n, n);
+        self.evaluate(&zero, omega, level, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))?;
+        let dx = jac.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| r[i]));
+        Ok((0..n).map(|i| -dx[(i, 0)]).collect())
+    }
+
     /// Residual `R(x; Ω, λ_F)` and, if asked, `∂R/∂x`, `∂R/∂Ω`, `∂R/∂λ_F`.
     pub fn evaluate(
         &mut self,

@@ -1,0 +1,92 @@
+//! The harmonic balance as a continuation problem: in the frequency Ω at a fixed force level
+//! (the FRF of one level, paper Section 4.3), or in the force level at a fixed frequency. One
+//! continuation code ([`crate::continuation`]) serves both.
+
+use faer::MatMut;
+
+use super::condensed::{CondensedHbm, HbmError, Jacobians};
+use crate::continuation::{continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError};
+
+/// A sweep that could not start (a failure during the sweep is a termination reason of the
+/// branch instead, with every point found before it).
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    #[error(transparent)]
+    Hbm(#[from] HbmError),
+    #[error(transparent)]
+    Continuation(#[from] ContinuationError),
+}
+
+/// `R(x; Ω) = 0` at a fixed level, λ = Ω (rad/s).
+pub struct FrequencySweep<'a, 'm> {
+    pub hbm: &'a mut CondensedHbm<'m>,
+    pub level: f64,
+}
+
+/// `R(x; λ_F) = 0` at a fixed Ω (rad/s), λ = the force level.
+pub struct LevelSweep<'a, 'm> {
+    pub hbm: &'a mut CondensedHbm<'m>,
+    pub omega: f64,
+}
+
+impl Problem for FrequencySweep<'_, '_> {
+    fn dimension(&self) -> usize {
+        self.hbm.dimension()
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: Some(dl), dlevel: None });
+        self.hbm.evaluate(x, omega, self.level, residual, jac).map_err(|e| ProblemError::new(e.to_string()))
+    }
+}
+
+impl Problem for LevelSweep<'_, '_> {
+    fn dimension(&self) -> usize {
+        self.hbm.dimension()
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        level: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: None, dlevel: Some(dl) });
+        self.hbm.evaluate(x, self.omega, level, residual, jac).map_err(|e| ProblemError::new(e.to_string()))
+    }
+}
+
+/// Continue the periodic response at force level `level` from `omega_start` to `omega_end`
+/// (rad/s, either direction), starting from the stuck solution.
+pub fn sweep_frequency<O: Observer + ?Sized>(
+    hbm: &mut CondensedHbm<'_>,
+    level: f64,
+    omega_start: f64,
+    omega_end: f64,
+    options: &Options,
+    observer: &mut O,
+) -> Result<Branch, SweepError> {
+    let guess = hbm.stuck_solution(omega_start, level)?;
+    Ok(continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?)
+}
+
+/// Continue the periodic response at frequency `omega` (rad/s) in the force level from
+/// `level_start` to `level_end`.
+pub fn sweep_level<O: Observer + ?Sized>(
+    hbm: &mut CondensedHbm<'_>,
+    omega: f64,
+    level_start: f64,
+    level_end: f64,
+    options: &Options,
+    observer: &mut O,
+) -> Result<Branch, SweepError> {
+    let guess = hbm.stuck_solution(omega, level_start)?;
+    Ok(continue_branch(&mut LevelSweep { hbm, omega }, &guess, level_start, level_end, options, observer)?)
+}
