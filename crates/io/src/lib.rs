@@ -3,3 +3,5 @@ pub mod matrix;
 pub mod output;
 pub mod plot;
 pub mod study;
+pub mod records;
+pub mod uff;
