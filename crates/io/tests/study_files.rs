@@ -89,3 +89,29 @@ fn a_dof_file_of_the_wrong_length_is_rejected() {
     assert!(msg.contains("study.toml:2:13: [model]: M (mass) is 2x2, expected 3x3"), "{msg}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_indefinite_sparse_mass_is_rejected() {
+    use faer::sparse::{SparseColMat, Triplet};
+    let dir = scratch_dir("study-sparse");
+    // diag(1, −1): a Cholesky of the sparse (coordinate) matrix fails at the second pivot.
+    let sparse = |d1: f64| {
+        Matrix::Sparse(
+            SparseColMat::try_new_from_triplets(2, 2, &[Triplet::new(0, 0, 1.0), Triplet::new(1, 1, d1)]).unwrap(),
+        )
+    };
+    mtx::write(&dir.join("mats/m.mtx"), &sparse(-1.0)).unwrap();
+    mtx::write(&dir.join("mats/k.mtx"), &sparse(1.0)).unwrap();
+    let study = "[model]\nmass_file = \"mats/m.mtx\"\nstiffness_file = \"mats/k.mtx\"\n\
+                 [[load]]\nname = \"p\"\ndof = \"1\"\n[excitation]\nlevels = [1.0]\n[sweep]\nstart_hz = 1.0\nend_hz = 2.0\n";
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let parsed = Study::load(dir.join("study.toml")).unwrap();
+    let msg = parsed.build_model().unwrap_err().to_string();
+    assert!(msg.contains("study.toml:2:13: [model]: the mass matrix is not positive definite"), "{msg}");
+    // The same files with a positive mass build, the DOFs numbered from 1.
+    mtx::write(&dir.join("mats/m.mtx"), &sparse(2.0)).unwrap();
+    let (model, _, outputs) = parsed.build_model().unwrap();
+    assert!(matches!(model.linear.mass, Matrix::Sparse(_)));
+    assert_eq!(outputs.iter().map(|o| o.name.as_str()).collect::<Vec<_>>(), ["1", "2"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
