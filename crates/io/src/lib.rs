@@ -1,4 +1,5 @@
 //! stickslip-io: files in and out (study files, matrix formats, CSV/NPZ/UFF, plots).
+pub mod analysis;
 pub mod matrix;
 pub mod output;
 pub mod plot;

@@ -1,9 +1,97 @@
+//! `stickslip run STUDY.toml --out DIR`: the FRF of every force level of a study.
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use stickslip_core::continuation::Point;
+use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
+use stickslip_io::output::{write_frf_csv, write_frf_npz, write_time_data};
+use stickslip_io::plot::plot_frfs;
+use stickslip_io::study::Study;
+
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input file.
-    pub input: std::path::PathBuf,
+    /// The study file (TOML; see docs/study-file.md).
+    pub study: PathBuf,
+    /// Output directory (created if needed).
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Worker threads for the force levels (default: one per core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bars.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`stickslip run` is not available yet (input {})", args.input.display())
+    let study = Study::load(&args.study)?;
+    let (model, excitation, outputs) = study.build_model()?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
+
+    let bars = MultiProgress::new();
+    if args.quiet {
+        bars.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let style = ProgressStyle::with_template("{prefix:>10} [{bar:30}] {percent:>3}% {msg}")
+        .expect("valid template")
+        .progress_chars("=> ");
+    let (start_hz, end_hz) = (study.sweep.start_hz, study.sweep.end_hz);
+    let started = Instant::now();
+    let runs: Vec<anyhow::Result<LevelRun>> = pool.install(|| {
+        excitation
+            .levels_n
+            .par_iter()
+            .map(|&level| {
+                let bar = bars.add(ProgressBar::new(1000));
+                bar.set_style(style.clone());
+                bar.set_prefix(format!("{level} N"));
+                let mut observer = |p: &Point, done: f64| {
+                    bar.set_position((done * 1000.0) as u64);
+                    bar.set_message(format!("{:.2} Hz", p.lambda / (2.0 * std::f64::consts::PI)));
+                };
+                let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
+                    .with_context(|| format!("level {level} N"))?;
+                bar.finish_with_message(format!(
+                    "{} points, {}",
+                    run.result.points.len(),
+                    describe_termination(&run.termination)
+                ));
+                Ok(run)
+            })
+            .collect()
+    });
+    let runs: Vec<LevelRun> = runs.into_iter().collect::<anyhow::Result<_>>()?;
+    let elapsed = started.elapsed();
+
+    let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
+    let frf = args.out.join("frf.csv");
+    write_frf_csv(&frf, &levels)?;
+    write_frf_npz(&args.out.join("frf.npz"), &levels)?;
+    let n_time = write_time_data(&args.out, &levels)?;
+    let plots = plot_frfs(&args.out, &levels, study.output_options.plot_format)?;
+    let points: usize = levels.iter().map(|l| l.points.len()).sum();
+    eprintln!(
+        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {}, frf.npz, {n_time} time-data file(s), {} plot(s)",
+        levels.len(),
+        elapsed.as_secs_f64(),
+        frf.display(),
+        plots.len()
+    );
+    let incomplete: Vec<String> = runs
+        .iter()
+        .filter(|r| !r.is_complete())
+        .map(|r| format!("level {} N {}", r.result.level_n, describe_termination(&r.termination)))
+        .collect();
+    if !incomplete.is_empty() {
+        anyhow::bail!(
+            "{} level(s) did not cross the band (their points are written):\n  {}",
+            incomplete.len(),
+            incomplete.join("\n  ")
+        );
+    }
+    Ok(())
 }

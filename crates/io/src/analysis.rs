@@ -1,0 +1,147 @@
+//! A study's frequency sweep at one force level, from the study's settings to result records:
+//! the harmonic balance with condensation (core `hbm`) continued across the band (core
+//! `continuation`), each converged point post-processed (core `post`) into an
+//! [`output::PointRecord`](crate::output::PointRecord).
+
+use stickslip_core::continuation::{Branch, Observer, Options, Predictor, TerminationReason};
+use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings as CoreHbmSettings, SweepError};
+use stickslip_core::model::NonlinearModel;
+use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
+
+use crate::output::{harmonics_from_coefficients, ElementRecord, LevelResult, OutputRecord, PointRecord};
+use crate::study::{self, Excitation, OutputSpec, Study};
+
+const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+
+/// The result of one level: the records of every converged point, and why the branch ended.
+pub struct LevelRun {
+    pub result: LevelResult,
+    pub termination: TerminationReason,
+    /// Total Newton iterations and residual evaluations over the sweep.
+    pub newton_iterations: usize,
+    pub evaluations: usize,
+}
+
+impl LevelRun {
+    /// Did the branch cross the whole band?
+    pub fn is_complete(&self) -> bool {
+        matches!(self.termination, TerminationReason::ReachedEnd)
+    }
+}
+
+/// Continuation options of a study: steps in Hz become scaled arclengths (1 = the whole band,
+/// Eq. 31's scaling is automatic), the Newton tolerance is relative to the linear response.
+pub fn continuation_options(study: &Study) -> Options {
+    let band = (study.sweep.end_hz - study.sweep.start_hz).abs();
+    let c = &study.continuation;
+    Options {
+        predictor: match c.predictor {
+            study::Predictor::Secant => Predictor::Secant,
+            study::Predictor::Tangent => Predictor::Tangent,
+            study::Predictor::Lagrange => Predictor::Lagrange,
+        },
+        initial_step: study.sweep.step_hz / band,
+        min_step: c.min_step_hz / band,
+        max_step: c.max_step_hz / band,
+        max_iterations: study.hbm.max_iterations,
+        rtol: study.hbm.tolerance,
+        max_points: c.max_points,
+        ..Options::default()
+    }
+}
+
+/// Sweep the band of `study` at force `level` (N). Every converged point is kept, whatever
+/// ends the branch; `observer` sees each point as it is accepted.
+pub fn run_level<O: Observer + ?Sized>(
+    study: &Study,
+    model: &NonlinearModel,
+    excitation: &Excitation,
+    outputs: &[OutputSpec],
+    level: f64,
+    observer: &mut O,
+) -> Result<LevelRun, SweepError> {
+    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings)?;
+    let options = continuation_options(study);
+    let branch: Branch = sweep_frequency(
+        &mut hbm,
+        level,
+        TWO_PI * study.sweep.start_hz,
+        TWO_PI * study.sweep.end_hz,
+        &options,
+        observer,
+    )?;
+    let selectors: Vec<OutputSelector> =
+        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
+    let mut points = Vec::with_capacity(branch.points.len());
+    for (index, p) in branch.points.iter().enumerate() {
+        let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
+        let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let residual = p.residual_norm / x_norm.max(f64::MIN_POSITIVE);
+        points.push(record(&result, p.iterations, residual, study.output_options.time_data.keeps(index)));
+    }
+    Ok(LevelRun {
+        newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
+        evaluations: branch.calls.residuals,
+        result: LevelResult { level_n: level, points },
+        termination: branch.termination,
+    })
+}
+
+/// A point's results as a record; the time signals only when `time_data`.
+pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool) -> PointRecord {
+    let keep = |v: &Vec<f64>| if time_data { v.clone() } else { Vec::new() };
+    PointRecord {
+        frequency_hz: p.frequency_hz(),
+        iterations,
+        residual,
+        outputs: p
+            .outputs
+            .iter()
+            .map(|o| {
+                let (a1, _) = o.harmonic(1);
+                OutputRecord {
+                    name: o.name.clone(),
+                    disp_frf: a1 / p.level,
+                    accel_frf: p.omega * p.omega * a1 / p.level,
+                    peak: o.peak,
+                    harmonics: harmonics_from_coefficients(&o.coeffs),
+                    disp: keep(&o.displacement),
+                    vel: keep(&o.velocity),
+                }
+            })
+            .collect(),
+        elements: p
+            .elements
+            .iter()
+            .map(|e| ElementRecord {
+                name: e.name.clone(),
+                energy_j: e.energy_per_cycle,
+                stick_fraction: e.stick_fraction,
+                loop_u: keep(&e.displacement),
+                loop_force: keep(&e.force),
+                slider_velocity: keep(&e.slider_velocity),
+            })
+            .collect(),
+    }
+}
+
+/// Say why a branch ended, for users.
+pub fn describe_termination(t: &TerminationReason) -> String {
+    match t {
+        TerminationReason::ReachedEnd => "reached the end of the band".into(),
+        TerminationReason::ReturnedToStart => "came back to the start of the band after a fold".into(),
+        TerminationReason::MaxPoints => "stopped at max_points (raise [continuation] max_points)".into(),
+        TerminationReason::FirstPointFailed { lambda, residual_norm, iterations } => format!(
+            "no convergence at the first point, {:.3} Hz, after {iterations} Newton iterations (residual {residual_norm:.3e}): start the band where the response is closer to linear, or use more harmonics",
+            lambda / TWO_PI
+        ),
+        TerminationReason::StepTooSmall { lambda, residual_norm, attempts, iterations } => format!(
+            "stopped after {:.3} Hz: {attempts} ever smaller steps failed ({iterations} Newton iterations, last residual {residual_norm:.3e}); try a smaller [continuation] min_step_hz, more [harmonic_balance] samples or another predictor",
+            lambda / TWO_PI
+        ),
+        TerminationReason::ProblemError { lambda, error, .. } => {
+            format!("the harmonic balance failed at {:.3} Hz: {error}", lambda / TWO_PI)
+        }
+    }
+}
