@@ -6,6 +6,7 @@
 //!   0..N of every response on the reference phase (the multi-harmonic comparison of Section 5.2).
 //! - [`frf`]: FRFs from stepped-sine and swept-sine records, and the identification of the
 //!   excitation level from an off-resonance response (Eq. 1).
+//! - [`peaks`]: resonance peaks of an FRF amplitude curve (frequency and amplitude).
 //! - [`shapes`]: DAC (Eq. 2) and MAC between shape vectors.
 //! - [`period`]: one period of motion at many points from records synchronised on the excitation
 //!   phase, sampled at regular phase steps (the vibrometry "video" of Fig. 9).
@@ -16,6 +17,7 @@
 
 pub mod frf;
 pub mod harmonics;
+pub mod peaks;
 pub mod period;
 pub mod phase;
 pub mod shapes;
