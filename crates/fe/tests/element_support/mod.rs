@@ -16,24 +16,57 @@ impl Lcg {
     }
 }
 
-/// Lowest eigenvalue ω² of `(K, M)` by inverse iteration on a sparse Cholesky factor of K,
-/// with the Rayleigh quotient of the converged vector. Converges like `(λ1/λ2)^iterations`.
-pub fn lowest_eigenvalue(model: &LinearModel, iterations: usize) -> f64 {
-    let stickslip_core::model::Matrix::Sparse(k) = &model.stiffness else { panic!("expected a sparse K") };
-    let llt = k.sp_cholesky(Side::Lower).expect("K positive definite");
+/// Lowest eigenvalue ω² of `(K, M)` outside the span of `deflate` (e.g. rigid-body motions),
+/// by inverse iteration on a sparse Cholesky factor of `K + σ M` (σ ≥ 0 shifts a free
+/// structure's zero eigenvalues away), the iterate kept M-orthogonal to `deflate`; returns the
+/// Rayleigh quotient of the converged vector. Converges like `((λ1+σ)/(λ2+σ))^iterations`.
+pub fn lowest_eigenvalue(model: &LinearModel, sigma: f64, deflate: &[Vec<f64>], iterations: usize) -> f64 {
+    use stickslip_core::model::Matrix;
+    let (Matrix::Sparse(k), Matrix::Sparse(m)) = (&model.stiffness, &model.mass) else {
+        panic!("expected sparse K, M")
+    };
+    let a = faer::sparse::SparseColMat::<usize, f64>::new(
+        k.symbolic().to_owned().unwrap(),
+        k.val().iter().zip(m.val()).map(|(a, b)| a + sigma * b).collect(),
+    );
+    let llt = a.sp_cholesky(Side::Lower).expect("K + σM positive definite");
     let n = model.n_dofs();
-    let mut x = Mat::<f64>::from_fn(n, 1, |i, _| 1.0 + (i % 7) as f64 * 0.1);
+    // M-orthonormal deflation basis (Gram-Schmidt in the M inner product).
+    let mut basis: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut mv = vec![0.0; n];
+    for v in deflate {
+        let mut v = v.clone();
+        for (b, mb) in &basis {
+            let c: f64 = v.iter().zip(mb).map(|(x, y)| x * y).sum();
+            v.iter_mut().zip(b).for_each(|(x, y)| *x -= c * y);
+        }
+        model.mass.mul_vec(&v, &mut mv);
+        let norm = v.iter().zip(&mv).map(|(x, y)| x * y).sum::<f64>().sqrt();
+        basis.push((v.iter().map(|x| x / norm).collect(), mv.iter().map(|x| x / norm).collect()));
+    }
+    let project = |x: &mut Vec<f64>| {
+        for (b, mb) in &basis {
+            let c: f64 = x.iter().zip(mb).map(|(p, q)| p * q).sum();
+            x.iter_mut().zip(b).for_each(|(p, q)| *p -= c * q);
+        }
+    };
+    let mut x: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64 * 0.1).collect();
+    project(&mut x);
     let mut mx = vec![0.0; n];
+    let mut rhs = Mat::<f64>::zeros(n, 1);
     for _ in 0..iterations {
-        let xv: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-        model.mass.mul_vec(&xv, &mut mx);
-        let mut rhs = Mat::<f64>::from_fn(n, 1, |i, _| mx[i]);
+        model.mass.mul_vec(&x, &mut mx);
+        for i in 0..n {
+            rhs[(i, 0)] = mx[i];
+        }
         llt.solve_in_place(rhs.as_mut());
         let norm = (0..n).map(|i| rhs[(i, 0)].powi(2)).sum::<f64>().sqrt();
-        x = Mat::from_fn(n, 1, |i, _| rhs[(i, 0)] / norm);
+        for i in 0..n {
+            x[i] = rhs[(i, 0)] / norm;
+        }
+        project(&mut x);
     }
-    let xv: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-    model.stiffness.bilinear(&xv, &xv) / model.mass.bilinear(&xv, &xv)
+    model.stiffness.bilinear(&x, &x) / model.mass.bilinear(&x, &x)
 }
 
 /// All frequencies in Hz of a small model by the dense eigensolution.
