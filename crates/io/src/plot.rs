@@ -42,20 +42,28 @@ impl Chart {
         // are left out rather than drawn at an arbitrary floor.
         let keep = |&(_, y): &(f64, f64)| y.is_finite() && (!self.log_y || y > 0.0);
         let all: Vec<(f64, f64)> = self.curves.iter().flat_map(|c| c.points.iter().copied().filter(keep)).collect();
-        if all.is_empty() {
-            return Err(format!(
-                "{}: nothing to plot (no finite{} values)",
-                self.title,
-                if self.log_y { " positive" } else { "" }
-            ));
+        // Nothing drawable (e.g. an output the excitation does not reach, zero on a log axis):
+        // an empty chart that says so, rather than no file.
+        let empty = all.is_empty();
+        let (mut x0, mut x1) = if empty {
+            min_max(self.curves.iter().flat_map(|c| c.points.iter().map(|p| p.0)).filter(|x| x.is_finite()))
+        } else {
+            min_max(all.iter().map(|p| p.0))
+        };
+        if !x0.is_finite() {
+            (x0, x1) = (0.0, 1.0);
         }
-        let (mut x0, mut x1) = min_max(all.iter().map(|p| p.0));
-        let (mut y0, mut y1) = min_max(all.iter().map(|p| p.1));
+        let (mut y0, mut y1) = if empty { (1e-12, 1.0) } else { min_max(all.iter().map(|p| p.1)) };
+        let title = if empty {
+            format!("{} (no {}values to draw)", self.title, if self.log_y { "positive " } else { "finite " })
+        } else {
+            self.title.clone()
+        };
         if x1 <= x0 {
             (x0, x1) = (x0 - 0.5 * x0.abs().max(1.0), x1 + 0.5 * x1.abs().max(1.0));
         }
         let mut chart = ChartBuilder::on(&root);
-        chart.caption(&self.title, (FONT, 22)).margin(15).x_label_area_size(45).y_label_area_size(85);
+        chart.caption(&title, (FONT, 22)).margin(15).x_label_area_size(45).y_label_area_size(85);
         if self.log_y {
             (y0, y1) = (y0 / 1.5, y1 * 1.5);
             let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;

@@ -2,9 +2,11 @@
 
 use std::path::PathBuf;
 
+use stickslip_io::study::PlotFormat;
+
 use stickslip_io::output::{
-    frf_columns, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_time_data, ElementRecord,
-    LevelResult, OutputRecord, PointRecord,
+    frf_columns, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results, write_time_data,
+    ElementRecord, LevelResult, OutputRecord, PointRecord,
 };
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -173,4 +175,18 @@ fn frf_npz_reads_back_exactly() {
     let (_, h3) = read(&mut npz, "slider-P_h3_amp_m");
     assert_eq!(h3[6], amps[6 * 8 + 3]);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn write_results_writes_table_arrays_time_data_and_plots() {
+    let dir = scratch_dir("all").join("run");
+    let files = write_results(&dir, &levels(64), PlotFormat::Svg).unwrap();
+    let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
+    assert_eq!(names, ["frf.csv", "frf.npz", "frf_mass.svg", "frf_slider-P.svg"]);
+    assert!(files.iter().all(|f| std::fs::metadata(f).unwrap().len() > 0));
+    // 5 points of level 0 carry time data (level 1 was built without).
+    assert_eq!(std::fs::read_dir(dir.join("points")).unwrap().count(), 5);
+    if std::env::var_os("STICKSLIP_KEEP_PLOTS").is_none() {
+        std::fs::remove_dir_all(dir.parent().unwrap()).unwrap();
+    }
 }

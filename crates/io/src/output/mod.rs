@@ -9,7 +9,9 @@
 mod csv;
 mod npz;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use crate::study::PlotFormat;
 
 pub use csv::{frf_columns, write_frf_csv, write_point_csv, write_time_data};
 pub use npz::write_frf_npz;
@@ -89,6 +91,20 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
             (c.hypot(s), (-s).atan2(c))
         }))
         .collect()
+}
+
+/// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`, the
+/// time data of the points that carry it (`points/`), and one FRF plot per output
+/// (`frf_<out>.<png|svg>`). Returns the paths of the FRF table, the NPZ file and the plots.
+pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
+    let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
+    write_frf_csv(&csv, levels)?;
+    write_frf_npz(&npz, levels)?;
+    let mut files = vec![csv, npz];
+    write_time_data(dir, levels)?;
+    files.extend(crate::plot::plot_frfs(dir, levels, plot_format)?);
+    Ok(files)
 }
 
 /// What went wrong writing results.
