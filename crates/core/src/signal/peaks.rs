@@ -60,7 +60,7 @@ fn refine(f: &[f64], a: &[f64], i: usize) -> Peak {
     let d01 = (y1 - y0) / (x1 - x0);
     let d12 = (y2 - y1) / (x2 - x1);
     let curvature = (d12 - d01) / (x2 - x0);
-    if !(curvature < 0.0) || !curvature.is_finite() {
+    if curvature >= 0.0 || !curvature.is_finite() {
         return Peak { frequency_hz: x1, amplitude: y1, index: i };
     }
     // y = y1 + d (x − x1) + c (x − x1)²  with d the slope at x1 of the parabola.
