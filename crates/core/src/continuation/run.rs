@@ -291,14 +291,18 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             let before_start = (lambda_new - self.lambda_start) * self.direction < 0.0;
             // A corrector that travelled farther than the step has likely jumped to another
             // part of the curve; a secant turning sharply has cut a fold too coarsely; the
-            // first step is oriented towards λ_end, so going back is a bad correction.
-            // A turn that persists after the step was halved four times is a corner of a
-            // non-smooth branch (a stick/slip onset makes the curve only C0 there), not a fold
-            // cut too coarsely: halving further would never reduce it. At a corner of angle α the
+            // first step is oriented towards λ_end, so going back is a bad correction. A turn
+            // that persists after `corner_after` halvings is a corner of a non-smooth branch
+            // (a stick/slip transition makes the curve only C0 there), not a fold cut too
+            // coarsely: halving further would never reduce it. At a corner of angle α the
             // corrector lands h·tan α from the prediction, proportional to the step, whereas a
             // jump to another part of the curve stays far whatever the step: accept corners up
             // to tan α = 10.
-            let corner = control.attempts >= 4;
+            // A step already so small that `corner_after` more halvings would fall below
+            // `min_step` gets the rule at once (otherwise the branch would stop at the corner).
+            let no_room = options.corner_after < 64
+                && control.step < options.min_step * 2f64.powi(options.corner_after as i32);
+            let corner = control.attempts >= options.corner_after || no_room;
             let travelled = distance(&self.z, &self.z_pred);
             let mut acceptable = (travelled <= control.step || (corner && travelled <= 10.0 * control.step))
                 && (self.turn_angle() <= options.max_angle || corner)

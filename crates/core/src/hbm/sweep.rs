@@ -5,7 +5,9 @@
 use faer::MatMut;
 
 use super::condensed::{CondensedHbm, HbmError, Jacobians};
-use crate::continuation::{continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError};
+use crate::continuation::{
+    continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError, Silent, TerminationReason,
+};
 
 /// A sweep that could not start (a failure during the sweep is a termination reason of the
 /// branch instead, with every point found before it).
@@ -65,6 +67,10 @@ impl Problem for LevelSweep<'_, '_> {
 
 /// Continue the periodic response at force level `level` from `omega_start` to `omega_end`
 /// (rad/s, either direction), starting from the stuck solution.
+///
+/// When Newton cannot reach the first point from the stuck solution (a joint already slipping
+/// hard at the start of the band), the start is found by continuation in the force level at
+/// `omega_start`, from a level where the joints stick up to `level`.
 pub fn sweep_frequency<O: Observer + ?Sized>(
     hbm: &mut CondensedHbm<'_>,
     level: f64,
@@ -74,7 +80,22 @@ pub fn sweep_frequency<O: Observer + ?Sized>(
     observer: &mut O,
 ) -> Result<Branch, SweepError> {
     let guess = hbm.stuck_solution(omega_start, level)?;
-    Ok(continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?)
+    let branch =
+        continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?;
+    if !matches!(branch.termination, TerminationReason::FirstPointFailed { .. }) {
+        return Ok(branch);
+    }
+    // Force-level continuation from 1/1000 of the level (stuck for any joint that slips at
+    // less than 1000x the force where it slips at `level`).
+    let ramp = Options { max_points: options.max_points.max(1000), ..options.clone() };
+    let start = sweep_level(hbm, omega_start, 1e-3 * level, level, &ramp, &mut Silent)?;
+    match (&start.termination, start.points.last()) {
+        (TerminationReason::ReachedEnd, Some(p)) => {
+            let guess = p.x.clone();
+            Ok(continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?)
+        }
+        _ => Ok(branch),
+    }
 }
 
 /// Continue the periodic response at frequency `omega` (rad/s) in the force level from
