@@ -47,6 +47,11 @@
 //!   `max_iterations`, a non-finite residual or a singular bordered matrix), when the corrector
 //!   travelled farther than the step itself (a jump to another part of the curve) or when the
 //!   secant turned by more than `max_angle` from the previous one (a fold taken too coarsely).
+//!   Friction makes branches only piecewise smooth (a stick/slip transition is a corner): a
+//!   turn that persists after `corner_after` halvings (or with a step too close to
+//!   `min_step` for that many) is a corner, not a coarse fold, and is accepted, with a
+//!   corrector travel up to 10 steps (at a corner of angle α it travels `h tan α`,
+//!   proportional to the step, whereas a jump stays far however small the step).
 //! - **ADAPT STEP**: a rejection halves `h` and retries from `z_i`; an acceptance after at most
 //!   `easy_iterations` Newton iterations multiplies `h` by `growth` (not right after a
 //!   rejection); `h` stays within `[min_step, max_step]`.
@@ -143,6 +148,9 @@ pub struct Options {
     pub first_point_max_iterations: usize,
     /// Largest turn (radians) of the secant between consecutive steps.
     pub max_angle: f64,
+    /// After this many halvings for one point, a turn beyond `max_angle` is taken for a
+    /// corner of a non-smooth branch and accepted (see ACCEPT-REJECT).
+    pub corner_after: usize,
     /// Relative residual tolerance, of the residual scale.
     pub rtol: f64,
     /// Absolute residual floor (residual units): the tolerance never goes below it.
@@ -163,6 +171,7 @@ impl Default for Options {
             max_iterations: 10,
             first_point_max_iterations: 50,
             max_angle: 0.5,
+            corner_after: 4,
             rtol: 1e-10,
             atol: 1e-14,
             max_points: 10_000,
@@ -319,6 +328,7 @@ impl Options {
             self.max_angle,
             "an angle in (0, π] radians",
         )?;
+        check(self.corner_after >= 1, "corner_after", self.corner_after as f64, "at least 1")?;
         check(positive(self.rtol), "rtol", self.rtol, "a positive number")?;
         check(self.atol.is_finite() && self.atol >= 0.0, "atol", self.atol, "a non-negative number")?;
         check(self.max_points >= 1, "max_points", self.max_points as f64, "at least 1")?;

@@ -297,11 +297,10 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             // coarsely: halving further would never reduce it. At a corner of angle α the
             // corrector lands h·tan α from the prediction, proportional to the step, whereas a
             // jump to another part of the curve stays far whatever the step: accept corners up
-            // to tan α = 10.
-            // A step already so small that `corner_after` more halvings would fall below
-            // `min_step` gets the rule at once (otherwise the branch would stop at the corner).
-            let no_room = options.corner_after < 64
-                && control.step < options.min_step * 2f64.powi(options.corner_after as i32);
+            // to tan α = 10. A step already so small that `corner_after` more halvings would
+            // fall below `min_step` gets the rule at once (else the branch stops at the corner).
+            let no_room =
+                options.corner_after < 64 && control.step < options.min_step * 2f64.powi(options.corner_after as i32);
             let corner = control.attempts >= options.corner_after || no_room;
             let travelled = distance(&self.z, &self.z_pred);
             let mut acceptable = (travelled <= control.step || (corner && travelled <= 10.0 * control.step))
