@@ -7,3 +7,4 @@ pub mod assembly;
 pub mod element;
 pub mod mesh;
 pub mod eigen;
+pub mod reduction;

@@ -1,0 +1,311 @@
+//! The reduction bases: constraint modes (Eqs. 3-4), cleaning of dynamic vectors on the
+//! retained DOFs (Eq. 5), orthogonalisation, projection.
+use std::time::Instant;
+
+use faer::sparse::linalg::matmul::sparse_dense_matmul;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::{Accum, Mat, Par, Side};
+use stickslip_core::model::{LinearModel, Matrix};
+
+use super::{reduced_model, Method, Reduction, ReductionError, ReductionOptions, Release};
+use crate::eigen::{self, to_sparse, EigenOptions, EigenSolution, ShiftedFactor};
+
+/// Retained (r) and eliminated (e) DOFs.
+struct Partition {
+    retained: Vec<usize>,
+    interior: Vec<usize>,
+    /// Position of each full DOF in the interior list (`None` for retained DOFs).
+    interior_pos: Vec<Option<usize>>,
+}
+
+fn partition(model: &LinearModel, retained: &[usize]) -> Result<Partition, ReductionError> {
+    let n = model.n_dofs();
+    if retained.is_empty() {
+        return Err(ReductionError::NothingRetained);
+    }
+    let mut is_retained = vec![false; n];
+    for &i in retained {
+        if i >= n {
+            return Err(ReductionError::RetainedOutOfRange { index: i, n });
+        }
+        if is_retained[i] {
+            return Err(ReductionError::RetainedTwice(model.dofs[i].name.clone()));
+        }
+        is_retained[i] = true;
+    }
+    let interior: Vec<usize> = (0..n).filter(|&i| !is_retained[i]).collect();
+    let mut interior_pos = vec![None; n];
+    for (p, &i) in interior.iter().enumerate() {
+        interior_pos[i] = Some(p);
+    }
+    Ok(Partition { retained: retained.to_vec(), interior, interior_pos })
+}
+
+/// `A[e, e]` as a sparse matrix (interior order is increasing, so row indices stay sorted).
+fn interior_block(a: &SparseColMat<usize, f64>, part: &Partition) -> SparseColMat<usize, f64> {
+    let a = a.as_ref();
+    let ne = part.interior.len();
+    let mut col_ptr = Vec::with_capacity(ne + 1);
+    let mut rows = Vec::new();
+    let mut vals = Vec::new();
+    col_ptr.push(0);
+    for &j in &part.interior {
+        for (&i, &v) in a.symbolic().row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            if let Some(p) = part.interior_pos[i] {
+                rows.push(p);
+                vals.push(v);
+            }
+        }
+        col_ptr.push(rows.len());
+    }
+    SparseColMat::new(SymbolicSparseColMat::new_checked(ne, ne, col_ptr, None, rows), vals)
+}
+
+/// Constraint modes (Eqs. 3-4): `Ψ = [−K_ee⁻¹ K_er; I]`, one column per retained DOF, in the
+/// full DOF order.
+fn constraint_modes(k: &SparseColMat<usize, f64>, part: &Partition, kee: &ShiftedFactor) -> Mat<f64> {
+    let k = k.as_ref();
+    let (n, ne, nr) = (k.nrows(), part.interior.len(), part.retained.len());
+    let mut rhs = Mat::<f64>::zeros(ne, nr);
+    for (c, &j) in part.retained.iter().enumerate() {
+        for (&i, &v) in k.symbolic().row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+            if let Some(p) = part.interior_pos[i] {
+                rhs[(p, c)] = -v;
+            }
+        }
+    }
+    kee.solve_in_place(rhs.as_mut());
+    let mut psi = Mat::<f64>::zeros(n, nr);
+    for c in 0..nr {
+        for (p, &i) in part.interior.iter().enumerate() {
+            psi[(i, c)] = rhs[(p, c)];
+        }
+        psi[(part.retained[c], c)] = 1.0;
+    }
+    psi
+}
+
+/// Eq. 5: `Φ* = Φ − Σ_r Φ_r Ψ_r`, zero on the retained DOFs (set exactly).
+fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
+    let phi_r = Mat::<f64>::from_fn(part.retained.len(), phi.ncols(), |r, c| phi[(part.retained[r], c)]);
+    let mut out = phi - psi * &phi_r;
+    for &i in &part.retained {
+        for c in 0..out.ncols() {
+            out[(i, c)] = 0.0;
+        }
+    }
+    out
+}
+
+/// `A X` for a model matrix.
+fn apply(a: &Matrix, x: &Mat<f64>) -> Mat<f64> {
+    match a {
+        Matrix::Dense(d) => d * x,
+        Matrix::Sparse(s) => {
+            let mut out = Mat::<f64>::zeros(s.nrows(), x.ncols());
+            sparse_dense_matmul(out.as_mut(), Accum::Replace, s.as_ref(), x.as_ref(), 1.0, Par::rayon(0));
+            out
+        }
+    }
+}
+
+/// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry).
+pub(super) fn project_matrix(a: &Matrix, t: &Mat<f64>) -> Mat<f64> {
+    let at = apply(a, t);
+    let p = t.transpose() * &at;
+    Mat::from_fn(p.nrows(), p.ncols(), |i, j| 0.5 * (p[(i, j)] + p[(j, i)]))
+}
+
+/// Linear dependence threshold: a vector whose M-norm, once the span of the others is removed,
+/// is below 1e-10 of its own adds nothing but round-off to the basis (squared: 1e-20 on the
+/// eigenvalues of the M-Gram matrix of M-normalised vectors; 1e-14 keeps a margin above
+/// round-off of that Gram matrix).
+const DEPENDENCE: f64 = 1e-14;
+
+/// Rayleigh-Ritz on the span of `x`: an M-orthonormal, K-orthogonal basis of it (the
+/// K-orthogonalisation of the paper's Section 3.3), vectors ordered by increasing
+/// `φᵀKφ`. Linearly dependent vectors are dropped.
+fn orthonormalise(model: &LinearModel, x: Mat<f64>) -> Mat<f64> {
+    if x.ncols() == 0 {
+        return x;
+    }
+    let mx = apply(&model.mass, &x);
+    let mut gm = x.transpose() * &mx;
+    // Unit M-norm columns first, so that the dependence test is scale-free.
+    let scale: Vec<f64> = (0..x.ncols()).map(|c| 1.0 / gm[(c, c)].max(f64::MIN_POSITIVE).sqrt()).collect();
+    for i in 0..gm.nrows() {
+        for j in 0..gm.ncols() {
+            gm[(i, j)] *= scale[i] * scale[j];
+        }
+    }
+    let evd = gm.self_adjoint_eigen(Side::Lower).expect("symmetric eigensolver on a small Gram matrix");
+    let mu: Vec<f64> = (0..gm.nrows()).map(|i| evd.S()[i]).collect();
+    let mu_max = mu.iter().cloned().fold(0.0, f64::max);
+    let kept: Vec<usize> = (0..mu.len()).filter(|&i| mu[i] > DEPENDENCE * mu_max).collect();
+    let q = Mat::<f64>::from_fn(x.ncols(), kept.len(), |r, c| evd.U()[(r, kept[c])] * scale[r] / mu[kept[c]].sqrt());
+    let z = &x * &q;
+    let gk = project_matrix(&model.stiffness, &z);
+    let evd = gk.self_adjoint_eigen(Side::Lower).expect("symmetric eigensolver on a small Gram matrix");
+    &z * evd.U()
+}
+
+fn eigen_options(opts: &ReductionOptions, count: usize) -> EigenOptions {
+    EigenOptions { count, ..opts.eigen.clone() }
+}
+
+fn frequencies(sol: &EigenSolution) -> (Vec<f64>, Vec<f64>) {
+    (sol.modes.frequencies_hz(), sol.residuals.clone())
+}
+
+fn finish(
+    model: &LinearModel,
+    part: &Partition,
+    psi: Mat<f64>,
+    dynamic: Mat<f64>,
+    method: Method,
+    modes: (Vec<f64>, Vec<f64>),
+    mut stages: Vec<(&'static str, f64)>,
+) -> Result<Reduction, ReductionError> {
+    let start = Instant::now();
+    let (nr, nd) = (psi.ncols(), dynamic.ncols());
+    let mut t = Mat::<f64>::zeros(psi.nrows(), nr + nd);
+    t.subcols_mut(0, nr).copy_from(&psi);
+    t.subcols_mut(nr, nd).copy_from(&dynamic);
+    let reduced = reduced_model(model, &t, &part.retained)?;
+    stages.push(("projection", start.elapsed().as_secs_f64()));
+    Ok(Reduction {
+        model: reduced,
+        basis: t,
+        retained: part.retained.clone(),
+        method,
+        basis_frequencies_hz: modes.0,
+        basis_residuals: modes.1,
+        stages,
+    })
+}
+
+/// Craig-Bampton: constraint modes + the `opts.modes` lowest fixed-interface modes (modes of
+/// `(K_ee, M_ee)`, retained DOFs clamped). One LDLᵀ of `K_ee` serves both: the eigensolver
+/// works at shift 0, which `K_ee` allows whenever the constraint modes exist.
+pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
+    let part = partition(model, &opts.retained)?;
+    let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let start = Instant::now();
+    let (kee, mee) = (interior_block(&k, &part), interior_block(&m, &part));
+    let factor =
+        ShiftedFactor::new(kee.as_ref(), Some(mee.as_ref()), 0.0).map_err(ReductionError::InteriorMechanism)?;
+    let psi = constraint_modes(&k, &part, &factor);
+    let mut stages = vec![("constraint modes", start.elapsed().as_secs_f64())];
+    let start = Instant::now();
+    let (dynamic, freqs) = if opts.modes > 0 {
+        let sol = eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?;
+        let mut phi = Mat::<f64>::zeros(model.n_dofs(), opts.modes);
+        for (p, &i) in part.interior.iter().enumerate() {
+            for c in 0..opts.modes {
+                phi[(i, c)] = sol.modes.shapes[(p, c)];
+            }
+        }
+        (phi, frequencies(&sol))
+    } else {
+        (Mat::zeros(model.n_dofs(), 0), (vec![], vec![]))
+    };
+    stages.push(("fixed-interface modes", start.elapsed().as_secs_f64()));
+    finish(model, &part, psi, dynamic, Method::CraigBampton, freqs, stages)
+}
+
+/// The paper's variant (Section 3.3): constraint modes + the `opts.modes` lowest free modes
+/// of the whole structure cleaned on the retained DOFs (Eq. 5) and orthogonalised. The span
+/// holds the free modes exactly, so the reduced model has the same first `opts.modes`
+/// eigenfrequencies as the full one.
+pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
+    let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (part, psi, mut stages) = static_part(model, &k, &opts.retained)?;
+    let start = Instant::now();
+    let sol = eigen::solve(&k, &m, &eigen_options(opts, opts.modes.max(1)))?;
+    stages.push(("free modes", start.elapsed().as_secs_f64()));
+    let start = Instant::now();
+    let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
+    let dynamic = orthonormalise(model, clean(&phi, &psi, &part));
+    stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    let freqs = frequencies(&sol);
+    finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
+}
+
+fn static_part(
+    model: &LinearModel,
+    k: &SparseColMat<usize, f64>,
+    retained: &[usize],
+) -> Result<(Partition, Mat<f64>, Vec<(&'static str, f64)>), ReductionError> {
+    let part = partition(model, retained)?;
+    let start = Instant::now();
+    let kee = interior_block(k, &part);
+    let factor = ShiftedFactor::new(kee.as_ref(), None, 0.0).map_err(ReductionError::InteriorMechanism)?;
+    let psi = constraint_modes(k, &part, &factor);
+    Ok((part, psi, vec![("constraint modes", start.elapsed().as_secs_f64())]))
+}
+
+/// The free-mode variant enriched with the `release_modes` lowest modes of the structure with
+/// the given joints released (Zucca & Epureanu): `K − Σ k_j d_j d_jᵀ`. The released modes are
+/// cleaned on the retained DOFs like the free ones and orthogonalised together with them;
+/// vectors already in the span are dropped. The kept free modes stay exact.
+pub fn enriched(
+    model: &LinearModel,
+    opts: &ReductionOptions,
+    releases: &[Release],
+    release_modes: usize,
+) -> Result<Reduction, ReductionError> {
+    let n = model.n_dofs();
+    let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (part, psi, mut stages) = static_part(model, &k, &opts.retained)?;
+    let start = Instant::now();
+    let sol = eigen::solve(&k, &m, &eigen_options(opts, opts.modes.max(1)))?;
+    stages.push(("free modes", start.elapsed().as_secs_f64()));
+    let start = Instant::now();
+    let k_released = released_stiffness(&k, releases, n)?;
+    let rel = eigen::solve(&k_released, &m, &eigen_options(opts, release_modes.max(1)))?;
+    stages.push(("released modes", start.elapsed().as_secs_f64()));
+    let start = Instant::now();
+    let (nf, nrel) = (opts.modes, release_modes.min(rel.modes.omega.len()));
+    let mut x = Mat::<f64>::zeros(n, nf + nrel);
+    x.subcols_mut(0, nf).copy_from(sol.modes.shapes.subcols(0, nf));
+    x.subcols_mut(nf, nrel).copy_from(rel.modes.shapes.subcols(0, nrel));
+    let dynamic = orthonormalise(model, clean(&x, &psi, &part));
+    stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    let (mut f, mut r) = frequencies(&sol);
+    f.truncate(nf);
+    r.truncate(nf);
+    f.extend(rel.modes.frequencies_hz().into_iter().take(nrel));
+    r.extend(rel.residuals.iter().take(nrel));
+    finish(model, &part, psi, dynamic, Method::Enriched, (f, r), stages)
+}
+
+/// `K − Σ_j k_j d_j d_jᵀ`, checked.
+fn released_stiffness(
+    k: &SparseColMat<usize, f64>,
+    releases: &[Release],
+    n: usize,
+) -> Result<SparseColMat<usize, f64>, ReductionError> {
+    let mut t = Vec::new();
+    for r in releases {
+        let bad = |message: String| ReductionError::Release { name: r.name.clone(), message };
+        if r.direction.len() != n {
+            return Err(bad(format!("direction has length {}, expected {n} (one value per DOF)", r.direction.len())));
+        }
+        if !(r.stiffness.is_finite() && r.stiffness > 0.0) {
+            return Err(bad(format!("stiffness must be finite and positive, got {}", r.stiffness)));
+        }
+        let support: Vec<(usize, f64)> =
+            r.direction.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(i, v)| (i, *v)).collect();
+        if support.is_empty() {
+            return Err(bad("direction is zero".into()));
+        }
+        for &(i, a) in &support {
+            for &(j, b) in &support {
+                t.push(Triplet::new(i, j, r.stiffness * a * b));
+            }
+        }
+    }
+    let d = SparseColMat::try_new_from_triplets(n, n, &t).expect("indices checked");
+    faer::sparse::ops::binary_op(k.as_ref(), d.as_ref(), |a, b| a.copied().unwrap_or(0.0) - b.copied().unwrap_or(0.0))
+        .map_err(|e| ReductionError::Release { name: "all".into(), message: format!("cannot form K: {e:?}") })
+}
