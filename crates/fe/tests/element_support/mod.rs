@@ -69,7 +69,28 @@ pub fn lowest_eigenvalue(model: &LinearModel, sigma: f64, deflate: &[Vec<f64>], 
     model.stiffness.bilinear(&x, &x) / model.mass.bilinear(&x, &x)
 }
 
-/// All frequencies in Hz of a small model by the dense eigensolution.
+/// All frequencies in Hz of a small model with positive definite K by a dense eigensolution
+/// of `L⁻¹ M L⁻ᵀ` (`K = L Lᵀ`, eigenvalues 1/ω²): unlike `LinearModel::dense_modes` it accepts
+/// a singular M (under-integrated C3D20R masses), whose zero eigenvalues are infinite
+/// frequencies and are dropped.
 pub fn dense_frequencies(model: &LinearModel) -> Vec<f64> {
-    model.dense_modes().expect("dense modes").frequencies_hz()
+    let k = model.stiffness.to_dense();
+    let m = model.mass.to_dense();
+    let llt = k.llt(Side::Lower).expect("K positive definite");
+    let l = llt.L();
+    let mut x = m.clone();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, x.as_mut(), faer::Par::Seq);
+    let mut a = x.transpose().to_owned();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, a.as_mut(), faer::Par::Seq);
+    let n = a.nrows();
+    let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let evd = a.self_adjoint_eigen(Side::Lower).expect("eigensolver");
+    let top = (0..n).map(|i| evd.S()[i]).fold(0.0f64, f64::max);
+    let mut f: Vec<f64> = (0..n)
+        .map(|i| evd.S()[i])
+        .filter(|&mu| mu > 1e-13 * top)
+        .map(|mu| (1.0 / mu).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect();
+    f.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    f
 }
