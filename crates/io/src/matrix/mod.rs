@@ -5,7 +5,14 @@
 //! Every reader reports the file and the 1-based line of what it could not use.
 use std::path::{Path, PathBuf};
 
+use faer::sparse::{SparseColMat, Triplet};
+use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix};
+
+pub mod abaqus;
+pub mod calculix;
+pub mod dmig;
 pub mod mtx;
+pub mod npz;
 
 /// What went wrong reading or writing a matrix file.
 #[derive(Debug, thiserror::Error)]
@@ -66,4 +73,99 @@ pub(crate) fn parse_index(
         return Err(MatrixFileError::parse(path, line, format!("{what} {i} is out of range 1..={max}")));
     }
     Ok(i - 1)
+}
+
+/// Entries of a symmetric matrix given by one triangle (either one, not both: both would
+/// double the off-diagonal terms), mirrored; duplicates are summed.
+#[derive(Default)]
+pub(crate) struct SymmetricTriplets {
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    lower: bool,
+    upper: bool,
+}
+
+impl SymmetricTriplets {
+    pub(crate) fn push(&mut self, path: &Path, line: usize, i: usize, j: usize, v: f64) -> Result<(), MatrixFileError> {
+        self.triplets.push(Triplet::new(i, j, v));
+        if i != j {
+            self.lower |= i > j;
+            self.upper |= i < j;
+            if self.lower && self.upper {
+                return Err(MatrixFileError::parse(
+                    path,
+                    line,
+                    "entries on both sides of the diagonal: a symmetric matrix file must list one triangle",
+                ));
+            }
+            self.triplets.push(Triplet::new(j, i, v));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn build(self, path: &Path, n: usize) -> Result<SparseColMat<usize, f64>, MatrixFileError> {
+        SparseColMat::try_new_from_triplets(n, n, &self.triplets)
+            .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))
+    }
+}
+
+/// Parse a Nastran/Fortran real: `1.5`, `1.5E+3`, `1.5D+3`, and Nastran's implicit exponent
+/// `1.5+3` / `-2.-4`.
+pub(crate) fn parse_real(path: &Path, line: usize, token: &str, what: &str) -> Result<f64, MatrixFileError> {
+    let t = token.trim();
+    let mut s = t.replace(['D', 'd'], "E");
+    if !s.contains(['E', 'e']) {
+        // A sign after the first character starts the exponent.
+        if let Some(p) = s[1..].find(['+', '-']).map(|p| p + 1) {
+            s.insert(p, 'E');
+        }
+    }
+    parse_f64(path, line, &s, what)
+        .map_err(|_| MatrixFileError::parse(path, line, format!("expected a number for {what}, got {t:?}")))
+}
+
+/// A sparse symmetric matrix over named DOFs (imports that carry their own DOF list).
+#[derive(Clone, Debug)]
+pub struct LabelledMatrix {
+    pub dofs: Vec<DofLabel>,
+    pub matrix: SparseColMat<usize, f64>,
+}
+
+impl LabelledMatrix {
+    pub(crate) fn nodal(keys: Vec<(u64, u8)>, matrix: SparseColMat<usize, f64>) -> Self {
+        LabelledMatrix { dofs: keys.into_iter().map(|(n, d)| DofLabel::nodal(n, d)).collect(), matrix }
+    }
+}
+
+/// An undamped model from a stiffness and a mass over possibly different DOF lists (a DOF
+/// with no mass entry, say): the model's DOFs are the union, in the stiffness's order then
+/// the mass's extra DOFs.
+pub fn model_from_pair(stiffness: LabelledMatrix, mass: LabelledMatrix) -> LinearModel {
+    let mut dofs = stiffness.dofs.clone();
+    let mut index: std::collections::HashMap<String, usize> =
+        dofs.iter().enumerate().map(|(i, d)| (d.name.clone(), i)).collect();
+    for d in &mass.dofs {
+        if !index.contains_key(&d.name) {
+            index.insert(d.name.clone(), dofs.len());
+            dofs.push(d.clone());
+        }
+    }
+    let n = dofs.len();
+    let remap = |m: &LabelledMatrix| {
+        let map: Vec<usize> = m.dofs.iter().map(|d| index[&d.name]).collect();
+        let a = m.matrix.as_ref();
+        let mut t = Vec::new();
+        for j in 0..a.ncols() {
+            for (&i, &v) in a.symbolic().row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+                t.push(Triplet::new(map[i], map[j], v));
+            }
+        }
+        SparseColMat::try_new_from_triplets(n, n, &t).expect("indices are in range")
+    };
+    LinearModel {
+        mass: Matrix::Sparse(remap(&mass)),
+        stiffness: Matrix::Sparse(remap(&stiffness)),
+        damping: Damping::None,
+        dofs,
+        loads: vec![],
+    }
 }

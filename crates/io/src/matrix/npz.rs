@@ -1,0 +1,77 @@
+//! Reduced (or any) models to NumPy `.npz`: `numpy.load("model.npz")` gives `M`, `K` (and `D`
+//! for a damping matrix) as dense 2-D float64 arrays, optionally the basis `T`, and the DOF
+//! map as `dof_node` / `dof_direction` (int64, -1 for DOFs without a node, e.g. modal
+//! coordinates) and `retained_index` (0-based index in the full model of each retained DOF).
+//! The DOF names go to a CSV next to it (see [`write_dof_csv`]).
+use std::io::Write;
+use std::path::Path;
+
+use faer::Mat;
+use npyz::WriterBuilder;
+use stickslip_core::model::{Damping, LinearModel};
+
+use super::MatrixFileError;
+
+/// What goes in the archive besides M, K, D.
+pub struct NpzExtras<'a> {
+    /// The reduction basis `T` (full DOFs × reduced DOFs).
+    pub basis: Option<&'a Mat<f64>>,
+    /// Full-model indices of the retained DOFs.
+    pub retained: &'a [usize],
+}
+
+/// Write `M`, `K`, `D` (if a damping matrix), the DOF map and the extras.
+pub fn write(path: &Path, model: &LinearModel, extras: &NpzExtras<'_>) -> Result<(), MatrixFileError> {
+    let io = |e: std::io::Error| MatrixFileError::io(path, e);
+    let mut npz = npyz::npz::NpzWriter::create(path).map_err(io)?;
+    let mut dense = |name: &str, m: &Mat<f64>| -> std::io::Result<()> {
+        let shape = [m.nrows() as u64, m.ncols() as u64];
+        let mut w = npz.array::<f64>(name, Default::default())?.default_dtype().shape(&shape).begin_nd()?;
+        // C order: row by row.
+        w.extend((0..m.nrows()).flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)])))?;
+        w.finish()
+    };
+    dense("M", &model.mass.to_dense()).map_err(io)?;
+    dense("K", &model.stiffness.to_dense()).map_err(io)?;
+    if let Damping::Matrix(d) = &model.damping {
+        dense("D", &d.to_dense()).map_err(io)?;
+    }
+    if let Some(t) = extras.basis {
+        dense("T", t).map_err(io)?;
+    }
+    let mut ints = |name: &str, v: &[i64]| -> std::io::Result<()> {
+        let mut w = npz.array::<i64>(name, Default::default())?.default_dtype().shape(&[v.len() as u64]).begin_nd()?;
+        w.extend(v.iter().copied())?;
+        w.finish()
+    };
+    let nodes: Vec<i64> = model.dofs.iter().map(|d| d.node.map(|n| n as i64).unwrap_or(-1)).collect();
+    let dirs: Vec<i64> = model.dofs.iter().map(|d| d.direction.map(|n| n as i64).unwrap_or(-1)).collect();
+    let retained: Vec<i64> = extras.retained.iter().map(|&i| i as i64).collect();
+    ints("dof_node", &nodes).map_err(io)?;
+    ints("dof_direction", &dirs).map_err(io)?;
+    ints("retained_index", &retained).map_err(io)?;
+    // Finish explicitly (writes the zip directory) so that errors are reported, not dropped.
+    let mut file = npz.zip_writer().finish().map_err(|e| io(std::io::Error::other(e)))?;
+    file.flush().map_err(io)
+}
+
+/// The DOF map as CSV: `index,name,node,direction,full_index` (node and direction empty for
+/// modal coordinates; `full_index` is the retained DOF's index in the full model).
+pub fn write_dof_csv(path: &Path, model: &LinearModel, retained: &[usize]) -> Result<(), MatrixFileError> {
+    let io = |e: std::io::Error| MatrixFileError::io(path, e);
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    writeln!(w, "index,name,node,direction,full_index").map_err(io)?;
+    for (i, d) in model.dofs.iter().enumerate() {
+        let opt = |v: Option<String>| v.unwrap_or_default();
+        writeln!(
+            w,
+            "{i},{},{},{},{}",
+            d.name,
+            opt(d.node.map(|n| n.to_string())),
+            opt(d.direction.map(|n| n.to_string())),
+            opt(retained.get(i).map(|n| n.to_string()))
+        )
+        .map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
