@@ -1,9 +1,243 @@
+//! `stickslip modes MODEL`: the lowest modes of a mesh or of imported matrices, with their
+//! effective masses and residuals; `modes.csv` and the mode shapes (VTK for meshes).
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use stickslip_core::model::LinearModel;
+use stickslip_fe::assembly::FeModel;
+use stickslip_fe::eigen::{self, to_sparse, EigenOptions, EigenSolution};
+use stickslip_io::matrix::{abaqus, calculix, dmig, model_from_pair, mtx, LabelledMatrix};
+
+/// How MODEL is read (by its extension, or by what exists next to it):
+///
+/// - `deck.inp`: an Abaqus/CalculiX deck, meshed and assembled;
+/// - `job` or `job.sti` / `job.mas` / `job.dof`: CalculiX's exported matrices;
+/// - `K.mtx --mass M.mtx`: Matrix Market files (first line `%%MatrixMarket`), or Abaqus
+///   `*MATRIX GENERATE` output (`job_STIF1.mtx --mass job_MASS1.mtx`);
+/// - `model.pch` / `.bdf` / `.dat`: Nastran DMIG matrices (`--dmig KAAX,MAAX` by default).
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// Model: a .inp deck, a CalculiX matrix job prefix, a stiffness .mtx (with --mass), or a
+    /// Nastran punch/bulk file with DMIG matrices.
+    pub model: PathBuf,
+    /// Mass matrix file for a stiffness given as .mtx (Matrix Market or Abaqus).
+    #[arg(long)]
+    pub mass: Option<PathBuf>,
+    /// Names of the stiffness and mass DMIG matrices.
+    #[arg(long, default_value = "KAAX,MAAX")]
+    pub dmig: String,
+}
+
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input file.
-    pub input: std::path::PathBuf,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Number of modes.
+    #[arg(long, default_value_t = 10)]
+    pub count: usize,
+    /// Find the modes nearest this frequency (Hz) instead of the lowest ones.
+    #[arg(long)]
+    pub shift: Option<f64>,
+    /// Directory for modes.csv and the mode shapes.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// A loaded model, with its mesh when it came from one.
+pub struct Loaded {
+    pub model: LinearModel,
+    pub fe: Option<FeModel>,
+}
+
+/// Read MODEL as [`ModelArgs`] says.
+pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
+    let path = &args.model;
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let start = Instant::now();
+    let loaded = match ext.as_str() {
+        "inp" => {
+            let mesh = stickslip_fe::mesh::inp::read(path).with_context(|| format!("reading {}", path.display()))?;
+            eprintln!("assembling {} ...", path.display());
+            let fe = FeModel::assemble(mesh).with_context(|| format!("assembling {}", path.display()))?;
+            Loaded { model: fe.model.clone(), fe: Some(fe) }
+        }
+        "msh" => bail!(
+            "{}: Gmsh meshes carry no material; write an .inp deck (or a study file with a mesh section) instead",
+            path.display()
+        ),
+        "mtx" => {
+            let mass = args.mass.as_ref().with_context(|| {
+                format!("{} is a stiffness matrix: give its mass matrix with --mass FILE", path.display())
+            })?;
+            let read = |p: &Path| -> anyhow::Result<LabelledMatrix> {
+                if is_matrix_market(p)? {
+                    let m = mtx::read(p)?;
+                    let n = m.nrows();
+                    let dofs =
+                        (0..n).map(|i| stickslip_core::model::DofLabel::named(format!("dof{}", i + 1))).collect();
+                    Ok(LabelledMatrix { dofs, matrix: to_sparse(&m) })
+                } else {
+                    Ok(abaqus::read(p)?)
+                }
+            };
+            let (k, m) = (read(path)?, read(mass)?);
+            if is_matrix_market(path)? && k.matrix.nrows() != m.matrix.nrows() {
+                bail!(
+                    "{} is {}x{} but {} is {}x{}",
+                    path.display(),
+                    k.matrix.nrows(),
+                    k.matrix.ncols(),
+                    mass.display(),
+                    m.matrix.nrows(),
+                    m.matrix.ncols()
+                );
+            }
+            Loaded { model: model_from_pair(k, m), fe: None }
+        }
+        "pch" | "bdf" | "dat" | "nas" => {
+            let (k, m) = args.dmig.split_once(',').context("--dmig expects STIFFNESS,MASS matrix names")?;
+            Loaded { model: dmig::read_model(path, k.trim(), m.trim())?, fe: None }
+        }
+        _ => {
+            let (sti, _, _) = calculix::job_files(path);
+            if !sti.exists() {
+                bail!(
+                    "{}: not a known model (.inp deck, CalculiX job prefix with {}, .mtx with --mass, or DMIG .pch)",
+                    path.display(),
+                    sti.display()
+                );
+            }
+            Loaded { model: calculix::read_job(path)?, fe: None }
+        }
+    };
+    eprintln!("model: {} DOFs ({:.2} s)", loaded.model.n_dofs(), start.elapsed().as_secs_f64());
+    Ok(loaded)
+}
+
+fn is_matrix_market(path: &Path) -> anyhow::Result<bool> {
+    let text = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(text.starts_with(b"%%MatrixMarket") || text.starts_with(b"%%matrixmarket"))
+}
+
+/// Shift in rad²/s² from a frequency in Hz.
+pub fn shift_from_hz(hz: Option<f64>) -> Option<f64> {
+    hz.map(|f| (2.0 * std::f64::consts::PI * f).powi(2) * f.signum())
+}
+
+/// Effective masses `(φᵀ M r_d)²` of a mass-normalised mode along the rigid translations
+/// `r_d` (1 on every DOF of direction `d`), d = x, y, z; `None` without nodal labels.
+pub fn effective_masses(model: &LinearModel, sol: &EigenSolution) -> Option<Vec<[f64; 3]>> {
+    if model.dofs.iter().all(|d| d.direction.is_none()) {
+        return None;
+    }
+    let n = model.n_dofs();
+    let mut mr = Vec::new();
+    for d in 1..=3u8 {
+        let r: Vec<f64> = model.dofs.iter().map(|l| if l.direction == Some(d) { 1.0 } else { 0.0 }).collect();
+        let mut out = vec![0.0; n];
+        model.mass.mul_vec(&r, &mut out);
+        mr.push(out);
+    }
+    let shapes = &sol.modes.shapes;
+    Some(
+        (0..shapes.ncols())
+            .map(|c| {
+                let mut e = [0.0; 3];
+                for (d, v) in mr.iter().enumerate() {
+                    let g: f64 = (0..n).map(|i| shapes[(i, c)] * v[i]).sum();
+                    e[d] = g * g;
+                }
+                e
+            })
+            .collect(),
+    )
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`stickslip modes` is not available yet (input {})", args.input.display())
+    let loaded = load(&args.model)?;
+    let model = &loaded.model;
+    let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let opts = EigenOptions { count: args.count, shift: shift_from_hz(args.shift), ..Default::default() };
+    let start = Instant::now();
+    eprintln!("solving for {} modes ...", args.count);
+    let sol = eigen::solve(&k, &m, &opts)?;
+    eprintln!(
+        "modes: {:.2} s ({} solves, {} restarts, shift {:.4e} rad^2/s^2, {} eigenvalues below it)",
+        start.elapsed().as_secs_f64(),
+        sol.solves,
+        sol.restarts,
+        sol.shift,
+        sol.below_shift
+    );
+    let eff = effective_masses(model, &sol);
+    let freqs = sol.modes.frequencies_hz();
+    let mut table = String::new();
+    table.push_str("mode,frequency_hz,eff_mass_x_kg,eff_mass_y_kg,eff_mass_z_kg,residual\n");
+    println!(
+        "{:>5} {:>16} {:>12} {:>12} {:>12} {:>10}",
+        "mode", "frequency (Hz)", "m_eff x (kg)", "m_eff y (kg)", "m_eff z (kg)", "residual"
+    );
+    for (r, f) in freqs.iter().enumerate() {
+        let e = eff.as_ref().map(|e| e[r]);
+        let cell = |d: usize| e.map(|e| format!("{:.6e}", e[d])).unwrap_or_default();
+        println!(
+            "{:>5} {:>16.6} {:>12} {:>12} {:>12} {:>10.2e}",
+            r + 1,
+            f,
+            cell(0),
+            cell(1),
+            cell(2),
+            sol.residuals[r]
+        );
+        table.push_str(&format!("{},{:.12e},{},{},{},{:.3e}\n", r + 1, f, cell(0), cell(1), cell(2), sol.residuals[r]));
+    }
+    if let Some(eff) = &eff {
+        let total: [f64; 3] = [0, 1, 2].map(|d| eff.iter().map(|e| e[d]).sum());
+        println!("sum of effective masses (kg): x {:.6e}, y {:.6e}, z {:.6e}", total[0], total[1], total[2]);
+    }
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let csv = dir.join("modes.csv");
+        std::fs::write(&csv, table).with_context(|| format!("writing {}", csv.display()))?;
+        write_shapes(dir, &loaded, &sol)?;
+        eprintln!("wrote {} and the mode shapes", csv.display());
+    }
+    Ok(())
+}
+
+/// Mode shapes: `modes.vtk` (one point vector per mode) for a mesh, `shapes.csv` (one row per
+/// DOF) for matrices.
+fn write_shapes(dir: &Path, loaded: &Loaded, sol: &EigenSolution) -> anyhow::Result<()> {
+    let shapes = &sol.modes.shapes;
+    let freqs = sol.modes.frequencies_hz();
+    if let Some(fe) = &loaded.fe {
+        let path = dir.join("modes.vtk");
+        let fields: Vec<(String, Vec<[f64; 3]>)> = (0..shapes.ncols())
+            .map(|c| {
+                let q: Vec<f64> = (0..shapes.nrows()).map(|i| shapes[(i, c)]).collect();
+                (format!("mode{}_{:.3}Hz", c + 1, freqs[c]), fe.nodal_displacements(&q))
+            })
+            .collect();
+        let mut w = std::io::BufWriter::new(
+            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?,
+        );
+        stickslip_fe::mesh::vtk::write(&mut w, "stickslip modes", &fe.mesh.nodes, &fe.mesh.solids, &fields)
+            .and_then(|_| w.flush())
+            .with_context(|| format!("writing {}", path.display()))?;
+    } else {
+        let path = dir.join("shapes.csv");
+        let mut w = std::io::BufWriter::new(
+            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?,
+        );
+        let header: Vec<String> = (0..shapes.ncols()).map(|c| format!("mode{}", c + 1)).collect();
+        writeln!(w, "dof,{}", header.join(","))?;
+        for (i, d) in loaded.model.dofs.iter().enumerate() {
+            let row: Vec<String> = (0..shapes.ncols()).map(|c| format!("{:e}", shapes[(i, c)])).collect();
+            writeln!(w, "{},{}", d.name, row.join(","))?;
+        }
+        w.flush()?;
+    }
+    Ok(())
 }
