@@ -43,7 +43,7 @@ pub enum MeshError {
     Syntax { at: Origin, msg: String },
     #[error("{at}: unknown keyword *{keyword} (supported keywords are listed in docs/fe.md)")]
     UnknownKeyword { at: Origin, keyword: String },
-    #[error("{at}: unsupported element type {kind} (supported: C3D4, C3D10, C3D8, C3D20, C3D20R, MASS, SPRING1, SPRING2, SPRINGA)")]
+    #[error("{at}: unsupported element type {kind} (supported: solids C3D4, C3D10, C3D8, C3D20, C3D20R, i.e. Gmsh types 4, 11, 5, 17; MASS, SPRING1, SPRING2, SPRINGA in decks)")]
     UnsupportedElement { at: Origin, kind: String },
     #[error("{at}: element {element} has {got} nodes, {kind} needs {expected}")]
     WrongNodeCount { at: Origin, element: u64, kind: String, got: usize, expected: usize },
