@@ -161,6 +161,24 @@ pub fn parse_table(text: &str, file: &str) -> Result<Table, RecordsError> {
     Ok(Table { file: file.into(), columns, data, lines: rows })
 }
 
+/// Write a numeric CSV: a header row of `columns`, then one line per row.
+pub fn write_table(path: &Path, columns: &[String], rows: &[Vec<f64>]) -> Result<(), RecordsError> {
+    let mut s = columns.join(",");
+    s.push('\n');
+    for row in rows {
+        if row.len() != columns.len() {
+            return Err(RecordsError::Header {
+                file: path.display().to_string(),
+                what: format!("a row of {} values for {} columns", row.len(), columns.len()),
+            });
+        }
+        let cells: Vec<String> = row.iter().map(|v| num(*v)).collect();
+        s.push_str(&cells.join(","));
+        s.push('\n');
+    }
+    std::fs::write(path, s).map_err(io_err(path))
+}
+
 /// Sample rate of a time column, checking that it is uniform: every time within 1 % of an
 /// interval of `t0 + j dt` (CSV files print times with finite digits).
 fn uniform_rate(time: &[f64], lines: &[usize], file: &str) -> Result<f64, RecordsError> {
@@ -486,7 +504,12 @@ pub fn frf_sets_from_uff(datasets: &[Dataset58], file: &str) -> Vec<FrfSet> {
             };
             FrfSet {
                 source: file.into(),
-                level_n: None,
+                // Written by `frf_set_to_uff` as id2 = "level <F> N".
+                level_n: d.ids[1]
+                    .trim()
+                    .strip_prefix("level ")
+                    .and_then(|l| l.strip_suffix(" N"))
+                    .and_then(|l| l.parse().ok()),
                 frequency_hz: d.x(),
                 curves: vec![FrfCurve {
                     name: d.ids[0].trim().replace([' ', ','], "_"),

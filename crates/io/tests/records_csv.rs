@@ -102,6 +102,7 @@ fn measured_frfs_of_several_levels_in_one_file() {
     assert_eq!(from_uff[0].curves[0].values, sets[1].curves[0].values);
     assert_eq!(from_uff[0].curves[0].unit, "m_s2_per_N");
     assert_eq!(from_uff[0].frequency_hz, sets[1].frequency_hz);
+    assert_eq!(from_uff[0].level_n, Some(2910.0));
 }
 
 #[test]
