@@ -138,6 +138,21 @@ fn duffing_frequency_sweeps_follow_the_closed_form_response_through_both_folds()
             assert_eq!(branch.termination, TerminationReason::ReachedEnd, "{label}");
             assert_eq!(branch.points.last().unwrap().lambda, to, "{label}");
             assert_eq!(fold_count(&branch.points), 2, "{label}: both folds of the hysteretic peak");
+            // Call counts of a point reached without rejection: one factorisation per Newton
+            // iteration (plus the tangent at the previous point, always for the first point),
+            // one residual per iterate plus at most one residual-only check, a Jacobian per
+            // iteration (and at the solution unless it was skipped).
+            for (i, p) in branch.points.iter().enumerate().take(branch.points.len() - 1).skip(1) {
+                if p.rejected == 0 {
+                    let tangent = usize::from(i == 1 || predictor == Predictor::Tangent);
+                    assert_eq!(p.calls.factorizations, p.iterations + tangent, "{label} {p:?}");
+                    assert!(p.calls.residuals == p.iterations + 1 || p.calls.residuals == p.iterations + 2, "{p:?}");
+                    assert!(p.calls.jacobians >= p.iterations && p.calls.jacobians <= p.iterations + 1, "{p:?}");
+                }
+            }
+            if predictor != Predictor::Tangent {
+                assert!(branch.calls.jacobians < branch.calls.residuals, "{label}: Jacobians at solutions skipped");
+            }
             for p in &branch.points {
                 // The residual is below 1e-10·F: the response equation, quadratic in the
                 // residual-perturbed force, holds to ~2e-10 relative; 1e-8 leaves margin.

@@ -228,7 +228,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         // First point: Newton at fixed λ_start from the caller's guess.
         self.scale.to_scaled(x_guess, self.lambda_start, &mut self.z);
         let (iterations, residual_norm) =
-            match self.newton(Constraint::FixedLambda(self.lambda_start), options.first_point_max_iterations) {
+            match self.newton(Constraint::FixedLambda(self.lambda_start), options.first_point_max_iterations, true) {
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
                 Outcome::Failed { iterations, residual_norm } => {
                     return TerminationReason::FirstPointFailed { lambda: self.lambda_start, residual_norm, iterations }
@@ -271,7 +271,8 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
 
             // CORRECT (Eq. 32)
             self.z.copy_from_slice(&self.z_pred);
-            let outcome = self.newton(Constraint::Arclength, options.max_iterations);
+            let outcome =
+                self.newton(Constraint::Arclength, options.max_iterations, options.predictor == Predictor::Tangent);
 
             // ACCEPT-REJECT
             let (iterations, residual_norm) = match outcome {
@@ -316,7 +317,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                     self.z[i] = self.z_last[i] + theta * (self.z[i] - self.z_last[i]);
                 }
                 self.z[n] = boundary / self.scale.lambda;
-                match self.newton(Constraint::FixedLambda(boundary), options.max_iterations) {
+                match self.newton(Constraint::FixedLambda(boundary), options.max_iterations, false) {
                     Outcome::Converged { iterations, residual_norm } => {
                         let step = distance(&self.z, &self.z_last);
                         let point = self.make_point(boundary, iterations, residual_norm, step, control.attempts);
@@ -480,12 +481,17 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         Ok(norm(&self.ws.residual))
     }
 
-    /// CORRECT: Newton from `z` under `constraint`, to `‖R‖ ≤ tolerance`. Every evaluation
-    /// includes the Jacobian, so the workspace holds ∂R at the returned point (for the
-    /// tangent), at the cost of one Jacobian per point that a converged check does not need.
-    fn newton(&mut self, constraint: Constraint, max_iterations: usize) -> Outcome {
+    /// CORRECT: Newton from `z` under `constraint`, to `‖R‖ ≤ tolerance`. With
+    /// `jacobian_at_solution` the last evaluation includes the Jacobian, so the workspace holds
+    /// ∂R at the returned point (for a tangent). Otherwise, once two residuals show quadratic
+    /// convergence (`r_k ≈ r_{k−1}²/r_{k−2}`, predicted below a tenth of the tolerance), the
+    /// residual is evaluated alone first: the Jacobian at the solution is never used, and a
+    /// wrong guess costs one residual.
+    fn newton(&mut self, constraint: Constraint, max_iterations: usize, jacobian_at_solution: bool) -> Outcome {
         let n = self.n;
         let mut iterations = 0;
+        // Residual norms of the two previous iterates.
+        let (mut older, mut old) = (f64::INFINITY, f64::INFINITY);
         loop {
             let lambda = match constraint {
                 Constraint::Arclength => self.z[n] * self.scale.lambda,
@@ -493,6 +499,13 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             };
             for (x, u) in self.x_phys.iter_mut().zip(&self.z) {
                 *x = u * self.scale.x;
+            }
+            if !jacobian_at_solution && iterations >= 2 && old * old / older <= 0.1 * self.tolerance {
+                match self.evaluate(lambda, false) {
+                    Ok(r) if r <= self.tolerance => return Outcome::Converged { iterations, residual_norm: r },
+                    Ok(_) => {}
+                    Err(error) => return Outcome::Problem { lambda, error },
+                }
             }
             let residual_norm = match self.evaluate(lambda, true) {
                 Ok(r) => r,
@@ -527,6 +540,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             for (z, dz) in self.z[..size].iter_mut().zip(&self.ws.rhs) {
                 *z += dz;
             }
+            (older, old) = (old, residual_norm);
             iterations += 1;
         }
     }
