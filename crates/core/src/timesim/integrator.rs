@@ -74,8 +74,8 @@ impl Scheme {
 
 /// Work done since the start of the integration (J), accumulated with the quadratures that
 /// make Newmark's average acceleration conserve energy exactly: over any step,
-/// `ΔT + ΔV_K + viscous + Σ elements = input` to round-off (for HHT the difference is the
-/// scheme's numerical dissipation).
+/// `ΔT + ΔV_K + viscous + Σ elements = input` to round-off. HHT weights the forces at
+/// `t_{n+1+α}`, so for it the balance holds only to second order in `ωh`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EnergyTally {
     /// Work of the excitation `Σ Δuᵀ (F_n + F_{n+1})/2`.
@@ -108,7 +108,7 @@ pub struct State {
     pub energy: EnergyTally,
     /// Value of the excitation's time function at `time`.
     excitation: f64,
-    /// Cached `K u` and `D v` at `time`.
+    /// Cached `D v` at `time`, and `K u` (kept current only for HHT, the one scheme that uses it).
     ku: Vec<f64>,
     dv: Vec<f64>,
 }
@@ -127,9 +127,10 @@ impl State {
     }
 }
 
-/// Newton stops when `|R|∞` is below this fraction of the element displacement scale: the
-/// laws are piecewise linear, so once the stick/slip set is right the residual drops to
-/// round-off (~1e-16 relative) and any tolerance well above it is reached exactly.
+/// Newton stops when `|R|∞` is below this fraction of the element displacement scale. For the
+/// piecewise-linear friction laws the residual drops to round-off (~1e-16 relative) as soon as
+/// the stick/slip set of the step is right; smooth laws converge quadratically, so the margin
+/// to round-off costs at most one more iteration.
 const NEWTON_TOLERANCE: f64 = 1e-11;
 const NEWTON_MAX_ITERATIONS: usize = 60;
 
