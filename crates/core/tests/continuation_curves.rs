@@ -230,6 +230,21 @@ fn a_problem_error_ends_the_branch_with_where_it_happened_and_keeps_the_points()
 }
 
 #[test]
+fn a_start_without_solution_ends_the_branch_with_no_points_and_the_reason() {
+    // x² + 4 = 1 has no real solution: Newton from x = 1 wanders until its iteration limit.
+    let branch = run(&mut Circle, 1.0, 2.0, 3.0, &Options::default());
+    assert!(branch.points.is_empty());
+    match branch.termination {
+        TerminationReason::FirstPointFailed { lambda, iterations, residual_norm } => {
+            assert_eq!(lambda, 2.0);
+            assert_eq!(iterations, Options::default().first_point_max_iterations);
+            assert!(residual_norm >= 3.0, "x² + 3 ≥ 3, got {residual_norm}");
+        }
+        other => panic!("expected FirstPointFailed, got {other:?}"),
+    }
+}
+
+#[test]
 fn invalid_input_is_an_error_naming_what_is_wrong() {
     let bad = Options { max_step: 1e-9, ..Options::default() };
     let err = continue_branch(&mut Circle, &[1.0], 0.0, 1.0, &bad, &mut Silent).unwrap_err();
@@ -238,6 +253,8 @@ fn invalid_input_is_an_error_naming_what_is_wrong() {
     assert!(err.to_string().contains("expected 1"), "{err}");
     let err = continue_branch(&mut Circle, &[1.0], 0.3, 0.3, &Options::default(), &mut Silent).unwrap_err();
     assert!(err.to_string().contains("empty"), "{err}");
+    let err = continue_branch(&mut Circle, &[f64::NAN], 0.0, 1.0, &Options::default(), &mut Silent).unwrap_err();
+    assert!(err.to_string().contains("not finite"), "{err}");
 }
 
 #[test]
