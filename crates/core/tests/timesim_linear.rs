@@ -137,11 +137,15 @@ fn smooth_nonlinear_steady_state_converges_at_second_order() {
 
 #[test]
 fn sparse_and_modal_paths_agree_with_dense() {
-    // A 450-DOF chain (above the sparse threshold) stored sparse, integrated 40 steps from
-    // rest, against the same model stored dense (dense inverse): the two factorisations must
-    // agree to round-off (1e-9 relative allows the conditioning of S, ~1e4).
+    // A 450-DOF chain (above the sparse threshold) with a Jenkins joint at its tip, stored
+    // sparse, integrated 40 steps from rest, against the same model stored dense (dense
+    // inverse): the two factorisations must agree to round-off (1e-9 relative allows the
+    // conditioning of S, ~1e4), stick/slip decisions included.
     let n = 450;
-    let dense = chain(n, 1.0, 1.0e6, 5.0, 1.0e-7, vec![]);
+    let joint = || -> Vec<(Box<dyn stickslip_core::elements::Element>, usize, Option<usize>)> {
+        vec![(Box::new(stickslip_core::elements::Jenkins::new(1.0e6, 10.0).unwrap()), n - 1, None)]
+    };
+    let dense = chain(n, 1.0, 1.0e6, 5.0, 1.0e-7, joint());
     let to_sparse = |m: &Matrix| {
         let d = m.to_dense();
         let mut t = Vec::new();
@@ -157,9 +161,17 @@ fn sparse_and_modal_paths_agree_with_dense() {
     let mut lin = dense.linear.clone();
     lin.mass = to_sparse(&lin.mass);
     lin.stiffness = to_sparse(&lin.stiffness);
-    let sparse = NonlinearModel::new(lin, vec![]).unwrap();
+    let sparse_joint = joint()
+        .into_iter()
+        .map(|(law, i, j)| stickslip_core::model::ElementSite {
+            name: "tip".into(),
+            law,
+            directions: vec![stickslip_core::model::relative_direction(n, i, j)],
+        })
+        .collect();
+    let sparse = NonlinearModel::new(lin, sparse_joint).unwrap();
     let mut load = vec![0.0; n];
-    load[n - 1] = 1.0;
+    load[n - 1] = 1000.0;
     let run = |model: &NonlinearModel| {
         let h = 1e-4;
         let mut it = Integrator::new(model, Scheme::Hht { alpha: -0.05 }, h).unwrap();
@@ -168,6 +180,7 @@ fn sparse_and_modal_paths_agree_with_dense() {
             let t = k as f64 * h;
             it.step(&mut s, &load, (500.0 * (t - 0.05 * h)).cos(), (500.0 * t).cos()).unwrap();
         }
+        assert!(s.element_history[0] != 0.0, "the joint must have slipped");
         s.displacement
     };
     let (a, b) = (run(&dense), run(&sparse));
