@@ -42,7 +42,10 @@
 //!   ```
 //!
 //!   (Eq. 32 writes the last row as `2 (z_p − z_i)ᵀ`, the same hyperplane), until
-//!   `‖R‖ ≤ max(rtol s_R, atol)`.
+//!   `‖R‖ ≤ max(rtol s_R, atol)`. The `(n+1)×(n+1)` system is factored by partial-pivot LU in
+//!   place, on buffers allocated once per branch. Once Newton converges quadratically, the
+//!   predicted last iterate is checked with a residual alone, saving the Jacobian at the
+//!   solution that only the tangent predictor uses.
 //! - **ACCEPT-REJECT**: a correction is rejected when Newton fails (no convergence within
 //!   `max_iterations`, a non-finite residual or a singular bordered matrix), when the corrector
 //!   travelled farther than the step itself (a jump to another part of the curve) or when the
@@ -63,6 +66,45 @@
 //!
 //! Progress goes to an [`Observer`]; the library never prints. Each point carries its call
 //! counts ([`Calls`]).
+//!
+//! # Example
+//!
+//! The S-curve `x³ − 3x = λ` has folds at `λ = ±2`; continued from `λ = −5` to `5` it passes
+//! both and ends exactly at `λ = 5`:
+//!
+//! ```
+//! use faer::MatMut;
+//! use stickslip_core::continuation::{continue_branch, Options, Problem, ProblemError, Silent, TerminationReason};
+//!
+//! struct SCurve;
+//! impl Problem for SCurve {
+//!     fn dimension(&self) -> usize {
+//!         1
+//!     }
+//!     fn evaluate(
+//!         &mut self,
+//!         x: &[f64],
+//!         lambda: f64,
+//!         residual: &mut [f64],
+//!         jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+//!     ) -> Result<(), ProblemError> {
+//!         residual[0] = x[0].powi(3) - 3.0 * x[0] - lambda;
+//!         if let Some((mut dr_dx, dr_dlambda)) = jacobian {
+//!             dr_dx[(0, 0)] = 3.0 * x[0] * x[0] - 3.0;
+//!             dr_dlambda[0] = -1.0;
+//!         }
+//!         Ok(())
+//!     }
+//! }
+//!
+//! let branch = continue_branch(&mut SCurve, &[-2.0], -5.0, 5.0, &Options::default(), &mut Silent)?;
+//! assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+//! let last = branch.points.last().unwrap();
+//! assert_eq!(last.lambda, 5.0);
+//! // On the upper branch, to the residual tolerance 1e-10 ‖R(0, −5)‖ = 5e-10.
+//! assert!((last.x[0].powi(3) - 3.0 * last.x[0] - 5.0).abs() <= 5e-10 && last.x[0] > 2.0);
+//! # Ok::<(), stickslip_core::continuation::ContinuationError>(())
+//! ```
 
 mod linear;
 mod run;
