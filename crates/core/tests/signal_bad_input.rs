@@ -42,3 +42,16 @@ fn a_reference_without_cycles_is_refused() {
     assert!(extract(&r, &[], 0.0, &SyncOptions::per_cycle(1)).is_err());
     assert_eq!(extract(&r, &[], 1000.0, &SyncOptions::per_cycle(0)).unwrap_err(), SignalError::NoHarmonics);
 }
+
+#[test]
+fn a_cycle_with_fewer_samples_than_coefficients_is_refused() {
+    // 10.5 samples per cycle: harmonic 5 is below Nyquist (5 < 5.25), but some cycles hold 10
+    // samples for 11 coefficients; per-cycle fitting is impossible, two cycles per block work.
+    let fs = 1050.0;
+    let r = sine(100.0, fs, 2100);
+    let e = extract(&r, &[("y", &r)], fs, &SyncOptions::per_cycle(5)).unwrap_err();
+    assert!(matches!(e, SignalError::TooFewSamples { samples: 10, coefficients: 11, .. }), "{e:?}");
+    assert!(e.to_string().contains("more cycles per block"), "{e}");
+    let two = SyncOptions { n_harmonics: 5, cycles_per_block: 2, skip_cycles: 0 };
+    assert!(extract(&r, &[("y", &r)], fs, &two).is_ok());
+}

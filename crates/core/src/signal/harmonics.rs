@@ -155,6 +155,9 @@ pub fn extract(
         }
         let start_s = chunk[0].start_s;
         let end_s = chunk[chunk.len() - 1].end_s;
+        if n < n_coeffs {
+            return Err(SignalError::TooFewSamples { time_s: start_s, samples: n, coefficients: n_coeffs });
+        }
         let solution = basis_mat.as_ref().subrows(0, n).qr().solve_lstsq(rhs.as_ref().subrows(0, n));
         let coeffs = |col: usize| (0..n_coeffs).map(|c| solution[(c, col)]).collect::<Vec<f64>>();
         let mut reference_coeffs = coeffs(0);

@@ -41,6 +41,8 @@ pub enum SignalError {
         max_harmonics: usize,
         needed_rate_hz: f64,
     },
+    #[error("the block starting at {time_s:.6} s holds {samples} samples, fewer than the {coefficients} coefficients of harmonics 0..N: use fewer harmonics, more cycles per block, or sample faster")]
+    TooFewSamples { time_s: f64, samples: usize, coefficients: usize },
     #[error("the number of harmonics must be at least 1, got 0")]
     NoHarmonics,
     #[error("the number of cycles per block must be at least 1, got 0")]
