@@ -20,6 +20,8 @@ dof = "a"
 name = "j1"
 law = "jenkins"
 between = ["a", "b"]
+stiffness = 1.0e4
+replaces_stiffness = true
 threshold = 5.0
 
 [excitation]
@@ -49,7 +51,7 @@ fn build_error(text: &str) -> String {
 fn the_good_study_builds() {
     let (model, excitation, outputs) = Study::parse(GOOD, "study.toml").unwrap().build_model().unwrap();
     assert_eq!(model.elements.len(), 1);
-    // Paper form by default: k = VᵀKV along e_a − e_b = K_aa + K_bb − 2 K_ab = 6e4 N/m.
+    // `between` acts on the relative displacement U_a − U_b.
     assert_eq!(model.elements[0].directions, vec![vec![1.0, -1.0]]);
     assert_eq!(excitation.levels_n, vec![1.0, 2.0]);
     // No [[output]]: every DOF of a small model is reported.
@@ -65,14 +67,14 @@ fn malformed_toml_names_line_and_column() {
 #[test]
 fn unknown_key_lists_the_valid_keys() {
     let msg = parse_error(&broken("threshold = 5.0", "threshhold = 5.0"));
-    assert!(msg.starts_with("study.toml:17:1: [[joint]]: unknown field"), "{msg}");
+    assert!(msg.starts_with("study.toml:19:1: [[joint]]: unknown field"), "{msg}");
     assert!(msg.contains("unknown field `threshhold`") && msg.contains("`threshold`"), "{msg}");
 }
 
 #[test]
 fn wrong_type_says_what_is_expected() {
     let msg = parse_error(&broken("levels = [1.0, 2.0]", "levels = \"high\""));
-    assert!(msg.starts_with("study.toml:20:10: ") && msg.contains("expected a sequence"), "{msg}");
+    assert!(msg.starts_with("study.toml:22:10: ") && msg.contains("expected a sequence"), "{msg}");
 }
 
 #[test]
@@ -105,13 +107,13 @@ fn indefinite_mass_is_rejected() {
 #[test]
 fn negative_threshold_is_rejected() {
     let msg = parse_error(&broken("threshold = 5.0", "threshold = -3"));
-    assert_eq!(msg, "study.toml:17:13: [[joint]] \"j1\": threshold must be > 0 N, got -3");
+    assert_eq!(msg, "study.toml:19:13: [[joint]] \"j1\": threshold must be > 0 N, got -3");
 }
 
 #[test]
 fn empty_band_is_rejected() {
     let msg = parse_error(&broken("end_hz = 30.0", "end_hz = 10.0"));
-    assert!(msg.starts_with("study.toml:24:10: [sweep]: empty band"), "{msg}");
+    assert!(msg.starts_with("study.toml:26:10: [sweep]: empty band"), "{msg}");
 }
 
 #[test]
@@ -123,7 +125,7 @@ fn unknown_dof_names_the_known_ones() {
 #[test]
 fn parameter_of_another_law_is_rejected() {
     let msg = parse_error(&broken("threshold = 5.0", "threshold = 5.0\nk3 = 1.0"));
-    assert!(msg.starts_with("study.toml:18:6: [[joint]] \"j1\": `k3` is not a parameter of law \"jenkins\""), "{msg}");
+    assert!(msg.starts_with("study.toml:20:6: [[joint]] \"j1\": `k3` is not a parameter of law \"jenkins\""), "{msg}");
 }
 
 #[test]
@@ -139,4 +141,32 @@ fn missing_matrix_file_names_the_file() {
         .replace("stiffness = [[3.0e4, -1.0e4], [-1.0e4, 1.0e4]]", "stiffness_file = \"k.mtx\"");
     let msg = build_error(&text);
     assert!(msg.contains("[model] mass_file") && msg.contains("no-such-mass.mtx"), "{msg}");
+}
+
+#[test]
+fn replacing_more_stiffness_than_the_model_has_is_rejected() {
+    // Without `stiffness`, the joint replaces all of the stiffness along e_a − e_b (Eq. 7),
+    // including part of a's spring to the ground, which leaves K − k V Vᵀ indefinite.
+    let msg = build_error(&broken("stiffness = 1.0e4\nreplaces_stiffness = true\n", ""));
+    assert!(
+        msg.starts_with("study.toml:16:11: [[joint]] \"j1\": with the joints \"j1\" (1.5e4 N/m) slipping"),
+        "{msg}"
+    );
+    assert!(msg.contains("negative eigenvalue"), "{msg}");
+}
+
+#[test]
+fn paper_form_stiffness_along_a_relative_direction() {
+    // Two DOFs, each with 2e4 N/m to the ground, 1e4 N/m between them. Moving them apart by u
+    // symmetrically (U = ±u/2, the unit direction of Eq. 7 scaled) stores
+    // ½ (2·2e4·(u/2)² + 1e4·u²) = ½ (2e4) u²: the joint replaces k = 2e4 N/m on u = U_a − U_b.
+    let text =
+        broken("stiffness = [[3.0e4, -1.0e4], [-1.0e4, 1.0e4]]", "stiffness = [[3.0e4, -1.0e4], [-1.0e4, 3.0e4]]")
+            .replace("stiffness = 1.0e4\nreplaces_stiffness = true\n", "");
+    let (model, _, _) = Study::parse(&text, "study.toml").unwrap().build_model().unwrap();
+    let law = &model.elements[0].law;
+    let (mut state, mut g) = (vec![0.0; law.n_state()], [0.0]);
+    // Gross slip: g = F_c − k u, exact in binary for these values.
+    law.update(&[1.0], &[0.0], &mut state, &mut g, None);
+    assert_eq!(g[0], 5.0 - 2.0e4);
 }

@@ -100,9 +100,15 @@ impl Study {
         }
 
         let mut sites = Vec::with_capacity(self.joints.len());
+        let mut replaced = Vec::new();
         for j in &self.joints {
-            sites.push(self.joint_site(&linear, j).map_err(|k| err(j.at, k))?);
+            let (site, replaced_k) = self.joint_site(&linear, j).map_err(|k| err(j.at, k))?;
+            if let Some(k) = replaced_k {
+                replaced.push((j, k, site.directions[0].clone()));
+            }
+            sites.push(site);
         }
+        check_slipped_stiffness(&linear, &replaced).map_err(|(j, k)| err(j.at, k))?;
 
         let load_name = match &self.excitation.load {
             Some(name) => name.clone(),
@@ -142,8 +148,9 @@ impl Study {
         Ok((model, excitation, outputs))
     }
 
-    /// The element of one joint on its application vector.
-    fn joint_site(&self, linear: &LinearModel, j: &JointSpec) -> Result<ElementSite, StudyErrorKind> {
+    /// The element of one joint on its application vector, and the stiffness it replaces in K
+    /// (paper form, Eq. 11), if any.
+    fn joint_site(&self, linear: &LinearModel, j: &JointSpec) -> Result<(ElementSite, Option<f64>), StudyErrorKind> {
         let ctx = format!("[[joint]] {:?}", j.name);
         let mut v = vector(linear, &j.placement, &ctx)?;
         if let Placement::Vector(_) = j.placement {
@@ -162,7 +169,11 @@ impl Study {
                 JointStiffness::Own(k) => Ok((k, false)),
                 JointStiffness::Replaces(k) => Ok((k, true)),
                 JointStiffness::ReplacesComputed => {
-                    let k = stiffness_along(linear, &v);
+                    // Eq. 7 is written for a unit vector: k_n = V_nᵀ K V_n with V_n = V/|V|. The
+                    // element sees u = Vᵀ U = |V| u_n, so the same energy needs k = k_n / |V|²
+                    // (for `between`, |V|² = 2; for `dof` and normalised vectors, 1).
+                    let norm2: f64 = v.iter().map(|x| x * x).sum();
+                    let k = stiffness_along(linear, &v) / (norm2 * norm2);
                     if k > 0.0 {
                         Ok((k, true))
                     } else {
@@ -173,15 +184,18 @@ impl Study {
                 }
             }
         };
+        let mut replaced = None;
         let law: Box<dyn Element> = match &j.law {
             LawSpec::Jenkins { threshold, stiffness } => {
                 let (k, replaces) = stuck(*stiffness)?;
+                replaced = replaces.then_some(k);
                 let law =
                     if replaces { Jenkins::replacing_stiffness(k, *threshold) } else { Jenkins::new(k, *threshold) };
                 Box::new(law.map_err(element_error)?)
             }
             LawSpec::Iwan { stiffness, slip_force, sliders } => {
                 let (k, replaces) = stuck(*stiffness)?;
+                replaced = replaces.then_some(k);
                 let law = Iwan::uniform(k, *slip_force, *sliders).map_err(element_error)?;
                 Box::new(if replaces { law.replacing_stiffness() } else { law })
             }
@@ -190,8 +204,49 @@ impl Study {
             }
             LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
         };
-        Ok(ElementSite { name: j.name.clone(), law, directions: vec![v] })
+        Ok((ElementSite { name: j.name.clone(), law, directions: vec![v] }, replaced))
     }
+}
+
+/// Largest model on which the slipped stiffness is checked (a dense symmetric eigensolution).
+const MAX_SLIPPED_CHECK_DOFS: usize = 3000;
+
+/// Joints that replace part of K (paper Eq. 11) leave `K − Σ k_e V_e V_eᵀ` when they all slip.
+/// It must stay positive semi-definite: a joint cannot remove more stiffness than the model
+/// has along its direction (the slipped structure would have a negative stiffness).
+fn check_slipped_stiffness<'a>(
+    linear: &LinearModel,
+    replaced: &[(&'a JointSpec, f64, Vec<f64>)],
+) -> Result<(), (&'a JointSpec, StudyErrorKind)> {
+    let n = linear.n_dofs();
+    if replaced.is_empty() || n > MAX_SLIPPED_CHECK_DOFS {
+        return Ok(());
+    }
+    let mut k = linear.stiffness.to_dense();
+    let scale = (0..n).map(|i| k[(i, i)].abs()).fold(0.0, f64::max);
+    for (_, kj, v) in replaced {
+        for c in 0..n {
+            for r in 0..n {
+                k[(r, c)] -= kj * v[r] * v[c];
+            }
+        }
+    }
+    let Ok(eigenvalues) = k.self_adjoint_eigenvalues(Side::Lower) else { return Ok(()) };
+    let lowest = eigenvalues.iter().copied().fold(f64::INFINITY, f64::min);
+    // Round-off of an exact cancellation (k_J = VᵀKV of a 1-DOF model) is ~1e-16 of the
+    // diagonal; 1e-9 leaves room for stiffnesses typed with 10 digits.
+    if lowest < -1e-9 * scale {
+        let names: Vec<String> = replaced.iter().map(|(j, k, _)| format!("{:?} ({k:e} N/m)", j.name)).collect();
+        return Err((
+            replaced[0].0,
+            StudyErrorKind::Invalid(format!(
+                "[[joint]] {:?}: with the joints {} slipping, the stiffness left, K − Σ k V Vᵀ, has a negative eigenvalue ({lowest:.3e} N/m): they replace more stiffness than the model has along their directions; give each the part of K it replaces with `stiffness`, or make it a separate element with replaces_stiffness = false",
+                replaced[0].0.name,
+                names.join(", ")
+            )),
+        ));
+    }
+    Ok(())
 }
 
 /// The vector over the model's DOFs that a placement stands for.
