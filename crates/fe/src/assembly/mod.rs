@@ -10,8 +10,8 @@ use rayon::prelude::*;
 use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix};
 
 use crate::element::{self, MassRule, SolidKind, Tabulated};
-use crate::mesh::{Mesh, MeshError};
-use csc::Entry;
+use crate::mesh::{Mesh, MeshError, Solid};
+use csc::{Builder, Entry};
 pub use dofs::DofMap;
 
 /// What stops an assembly, naming the element, node or set.
@@ -69,10 +69,23 @@ impl FeModel {
         if n == 0 {
             return Err(AssemblyError::Empty);
         }
-        let (entries, volume, solid_mass) = solid_entries(&mesh, &dofs, options.mass_rule)?;
-        let mut entries = entries;
-        point_entries(&mesh, &dofs, &mut entries)?;
-        let (k, m) = csc::build(n, entries);
+        for s in &mesh.solids {
+            if s.material.is_none() {
+                return Err(AssemblyError::NoMaterial { element: s.id, kind: s.kind.abaqus_name() });
+            }
+        }
+        let points = point_entries(&mesh, &dofs)?;
+        let mut counts = solid_counts(&mesh, &dofs);
+        for e in &points {
+            counts[e.col as usize] += 1;
+        }
+        let mut builder = Builder::new(&counts);
+        drop(counts);
+        let (volume, solid_mass) = solid_entries(&mesh, &dofs, options.mass_rule, &mut builder)?;
+        for e in points {
+            builder.push(e);
+        }
+        let (k, m) = builder.finish();
         let labels = dofs.independent.iter().map(|&(node, d)| DofLabel::nodal(mesh.nodes[node].id, d)).collect();
         // Built directly: K and M are symmetric by construction, and LinearModel::new's
         // symmetry check works on dense copies, out of reach at FE sizes.
@@ -128,111 +141,137 @@ impl FeModel {
 }
 
 /// Elements per parallel work unit: large enough to amortise the scheduling, small enough to
-/// balance two to a few dozen threads.
-const CHUNK: usize = 2048;
+/// balance the threads and keep each unit's contributions (~10 MB for tet10) in cache-sized
+/// buffers.
+const CHUNK: usize = 1024;
 
-/// Upper-triangle entries of all solids, in parallel over chunks of elements written into
-/// disjoint slices of one preallocated vector; also the volume and mass.
-fn solid_entries(mesh: &Mesh, dofs: &DofMap, mass_rule: MassRule) -> Result<(Vec<Entry>, f64, f64), AssemblyError> {
-    let tabs: Vec<Tabulated> = SolidKind::ALL.iter().map(|&k| Tabulated::new(k, mass_rule)).collect();
-    let tab_of = |k: SolidKind| &tabs[SolidKind::ALL.iter().position(|&x| x == k).unwrap()];
-    for s in &mesh.solids {
-        if s.material.is_none() {
-            return Err(AssemblyError::NoMaterial { element: s.id, kind: s.kind.abaqus_name() });
+/// Rows of `T` for the DOFs of a solid, node-major: `rows[ptr[p]..ptr[p + 1]]` for DOF `p`.
+fn element_rows(s: &Solid, dofs: &DofMap, rows: &mut Vec<(u32, f64)>, ptr: &mut Vec<usize>) {
+    rows.clear();
+    ptr.clear();
+    ptr.push(0);
+    for &a in &s.nodes {
+        for i in 0..3 {
+            rows.extend(dofs.row(dofs.offset[a] + i));
+            ptr.push(rows.len());
         }
     }
-    // Number of upper-triangle entries of each element (a full DOF maps to several model DOFs
-    // when it is a coupled slave).
-    let count = |s: &crate::mesh::Solid| -> usize {
-        let mut c = 0;
-        for &a in &s.nodes {
-            for i in 0..3 {
-                for (ra, _) in dofs.row(dofs.offset[a] + i) {
-                    for &b in &s.nodes {
-                        for j in 0..3 {
-                            c += dofs.row(dofs.offset[b] + j).filter(|&(rb, _)| ra <= rb).count();
+}
+
+/// Number of upper-triangle contributions of the solids to each column.
+fn solid_counts(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
+    let n = dofs.independent.len();
+    mesh.solids
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut counts = vec![0usize; n];
+            let (mut rows, mut ptr) = (Vec::new(), Vec::new());
+            for s in chunk {
+                element_rows(s, dofs, &mut rows, &mut ptr);
+                for &(ra, _) in &rows {
+                    for &(rb, _) in &rows {
+                        if ra <= rb {
+                            counts[rb as usize] += 1;
                         }
                     }
                 }
             }
-        }
-        c
-    };
-    let chunks: Vec<&[crate::mesh::Solid]> = mesh.solids.chunks(CHUNK).collect();
-    let counts: Vec<usize> = chunks.par_iter().map(|ch| ch.iter().map(count).sum()).collect();
-    let total: usize = counts.iter().sum();
-    let mut entries = vec![Entry::default(); total];
-    let mut slices = Vec::with_capacity(chunks.len());
-    let mut rest = entries.as_mut_slice();
-    for &c in &counts {
-        let (head, tail) = rest.split_at_mut(c);
-        slices.push(head);
-        rest = tail;
-    }
-    let results: Vec<Result<(f64, f64), AssemblyError>> = chunks
-        .par_iter()
-        .zip(slices.into_par_iter())
-        .map(|(chunk, out)| {
-            let mut k = vec![0.0; 60 * 60];
-            let mut m = vec![0.0; 20 * 20];
-            let mut xyz = [[0.0; 3]; 20];
-            let mut rows: Vec<(u32, f64)> = Vec::with_capacity(64);
-            let mut row_ptr: Vec<usize> = Vec::with_capacity(61);
-            let (mut volume, mut mass) = (0.0, 0.0);
-            let mut w = 0;
-            for s in chunk.iter() {
-                let nn = s.nodes.len();
-                for (x, &a) in xyz.iter_mut().zip(&s.nodes) {
-                    *x = mesh.nodes[a].xyz;
-                }
-                let mat = &mesh.materials[s.material.unwrap()].1;
-                let v = element::solid_matrices(tab_of(s.kind), &xyz[..nn], mat, &mut k, &mut m).map_err(|e| {
-                    AssemblyError::InvertedElement { element: s.id, kind: s.kind.abaqus_name(), det: e.det }
-                })?;
-                volume += v;
-                mass += v * mat.density;
-                // Rows of T for the element's DOFs, node-major.
-                rows.clear();
-                row_ptr.clear();
-                row_ptr.push(0);
-                for &a in &s.nodes {
-                    for i in 0..3 {
-                        rows.extend(dofs.row(dofs.offset[a] + i));
-                        row_ptr.push(rows.len());
+            counts
+        })
+        .reduce(
+            || vec![0usize; n],
+            |mut a, b| {
+                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+                a
+            },
+        )
+}
+
+/// Upper-triangle contributions of all solids, computed in parallel over chunks of elements
+/// (a few chunks per thread at a time) and scattered into the builder; returns the volume and
+/// mass.
+fn solid_entries(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    mass_rule: MassRule,
+    builder: &mut Builder,
+) -> Result<(f64, f64), AssemblyError> {
+    let tabs: Vec<Tabulated> = SolidKind::ALL.iter().map(|&k| Tabulated::new(k, mass_rule)).collect();
+    let tab_of = |k: SolidKind| &tabs[SolidKind::ALL.iter().position(|&x| x == k).unwrap()];
+    let chunks: Vec<&[Solid]> = mesh.solids.chunks(CHUNK).collect();
+    let batch = 2 * rayon::current_num_threads();
+    let (mut volume, mut mass) = (0.0, 0.0);
+    for group in chunks.chunks(batch) {
+        let results: Vec<Result<(Vec<Entry>, f64, f64), AssemblyError>> = group
+            .par_iter()
+            .map(|chunk| {
+                let mut k = vec![0.0; 60 * 60];
+                let mut m = vec![0.0; 20 * 20];
+                let mut xyz = [[0.0; 3]; 20];
+                let (mut rows, mut row_ptr) = (Vec::with_capacity(64), Vec::with_capacity(61));
+                let (mut volume, mut mass) = (0.0, 0.0);
+                let mut out = Vec::new();
+                for s in chunk.iter() {
+                    let nn = s.nodes.len();
+                    for (x, &a) in xyz.iter_mut().zip(&s.nodes) {
+                        *x = mesh.nodes[a].xyz;
                     }
-                }
-                let nd = 3 * nn;
-                for p in 0..nd {
-                    for q in 0..nd {
-                        let kpq = k[p * nd + q];
-                        let mpq = if p % 3 == q % 3 { m[(p / 3) * nn + q / 3] } else { 0.0 };
-                        for &(ra, ca) in &rows[row_ptr[p]..row_ptr[p + 1]] {
-                            for &(rb, cb) in &rows[row_ptr[q]..row_ptr[q + 1]] {
+                    let mat = &mesh.materials[s.material.expect("checked before")].1;
+                    let v = element::solid_matrices(tab_of(s.kind), &xyz[..nn], mat, &mut k, &mut m).map_err(|e| {
+                        AssemblyError::InvertedElement { element: s.id, kind: s.kind.abaqus_name(), det: e.det }
+                    })?;
+                    volume += v;
+                    mass += v * mat.density;
+                    element_rows(s, dofs, &mut rows, &mut row_ptr);
+                    let nd = 3 * nn;
+                    if rows.len() == nd && rows.iter().all(|r| r.1 == 1.0) {
+                        // Every DOF free (no fixed or coupled node): one contribution per pair.
+                        for p in 0..nd {
+                            let ra = rows[p].0;
+                            let mrow = &m[(p / 3) * nn..(p / 3) * nn + nn];
+                            for (q, &kpq) in k[p * nd..(p + 1) * nd].iter().enumerate() {
+                                let rb = rows[q].0;
                                 if ra <= rb {
-                                    let c = ca * cb;
-                                    out[w] = Entry { row: ra, col: rb, k: c * kpq, m: c * mpq };
-                                    w += 1;
+                                    let mpq = if p % 3 == q % 3 { mrow[q / 3] } else { 0.0 };
+                                    out.push(Entry { row: ra, col: rb, k: kpq, m: mpq });
+                                }
+                            }
+                        }
+                        continue;
+                    }
+                    for p in 0..nd {
+                        for q in 0..nd {
+                            let kpq = k[p * nd + q];
+                            let mpq = if p % 3 == q % 3 { m[(p / 3) * nn + q / 3] } else { 0.0 };
+                            for &(ra, ca) in &rows[row_ptr[p]..row_ptr[p + 1]] {
+                                for &(rb, cb) in &rows[row_ptr[q]..row_ptr[q + 1]] {
+                                    if ra <= rb {
+                                        let c = ca * cb;
+                                        out.push(Entry { row: ra, col: rb, k: c * kpq, m: c * mpq });
+                                    }
                                 }
                             }
                         }
                     }
                 }
+                Ok((out, volume, mass))
+            })
+            .collect();
+        for r in results {
+            let (entries, v, m) = r?;
+            volume += v;
+            mass += m;
+            for e in entries {
+                builder.push(e);
             }
-            debug_assert_eq!(w, out.len());
-            Ok((volume, mass))
-        })
-        .collect();
-    let (mut volume, mut mass) = (0.0, 0.0);
-    for r in results {
-        let (v, m) = r?;
-        volume += v;
-        mass += m;
+        }
     }
-    Ok((entries, volume, mass))
+    Ok((volume, mass))
 }
 
-/// Entries of the point elements (masses, springs, connectors).
-fn point_entries(mesh: &Mesh, dofs: &DofMap, out: &mut Vec<Entry>) -> Result<(), AssemblyError> {
+/// Upper-triangle contributions of the point elements (masses, springs, connectors).
+fn point_entries(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<Entry>, AssemblyError> {
+    let mut out = Vec::new();
     let mut ke = Vec::new();
     let mut me = Vec::new();
     for p in &mesh.points {
@@ -258,5 +297,5 @@ fn point_entries(mesh: &Mesh, dofs: &DofMap, out: &mut Vec<Entry>) -> Result<(),
             }
         }
     }
-    Ok(())
+    Ok(out)
 }
