@@ -77,12 +77,9 @@ impl Problem for DenseCubic {
         jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
     ) -> Result<(), ProblemError> {
         let n = x.len();
-        for i in 0..n {
-            let mut s = x[i].powi(3) - lambda * self.f[i];
-            for j in 0..n {
-                s += self.a[(i, j)] * x[j];
-            }
-            residual[i] = s;
+        for (i, r) in residual.iter_mut().enumerate() {
+            let ax: f64 = x.iter().enumerate().map(|(j, xj)| self.a[(i, j)] * xj).sum();
+            *r = ax + x[i].powi(3) - lambda * self.f[i];
         }
         if let Some((mut jx, dl)) = jacobian {
             for j in 0..n {
