@@ -252,3 +252,39 @@ pub fn plot_slider_velocity(path: &Path, point: &PointRecord, element: &str) -> 
     }
     .render(path)
 }
+
+/// Per level `i`: the harmonics of each output (`harmonics_level<i>_<out>`), and, at the point
+/// with time data where the first output's FRF is largest (the resonance, as in the paper's
+/// Fig. 17), each element's hysteresis loop (`loop_level<i>_<el>`) and slider velocity
+/// (`slider_level<i>_<el>`). Returns the files written.
+pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    let ext = format.extension();
+    let mut files = Vec::new();
+    for (i, level) in levels.iter().enumerate() {
+        let Some(p0) = level.points.first() else { continue };
+        for o in &p0.outputs {
+            if o.harmonics.len() > 1 {
+                let path = dir.join(format!("harmonics_level{i}_{}.{ext}", o.name));
+                plot_harmonics(&path, level, &o.name)?;
+                files.push(path);
+            }
+        }
+        let resonance =
+            level.points.iter().filter(|p| p.elements.iter().any(|e| !e.loop_u.is_empty())).max_by(|a, b| {
+                let amplitude = |p: &PointRecord| p.outputs.first().map_or(0.0, |o| o.disp_frf);
+                amplitude(a).total_cmp(&amplitude(b))
+            });
+        let Some(point) = resonance else { continue };
+        for e in point.elements.iter().filter(|e| !e.loop_u.is_empty()) {
+            let path = dir.join(format!("loop_level{i}_{}.{ext}", e.name));
+            plot_hysteresis(&path, point, &e.name)?;
+            files.push(path);
+            if !e.slider_velocity.is_empty() {
+                let path = dir.join(format!("slider_level{i}_{}.{ext}", e.name));
+                plot_slider_velocity(&path, point, &e.name)?;
+                files.push(path);
+            }
+        }
+    }
+    Ok(files)
+}

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use stickslip_core::elements::{Element, Jenkins};
 use stickslip_io::output::{ElementRecord, LevelResult, OutputRecord, PointRecord};
-use stickslip_io::plot::{plot_frf, plot_frfs, plot_harmonics, plot_hysteresis, plot_slider_velocity};
+use stickslip_io::plot::{
+    plot_frf, plot_frfs, plot_harmonics, plot_hysteresis, plot_level_details, plot_slider_velocity,
+};
 use stickslip_io::study::PlotFormat;
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -130,4 +132,18 @@ fn harmonics_hysteresis_and_slider_velocity_plots_are_written() {
     if std::env::var_os("STICKSLIP_KEEP_PLOTS").is_none() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+#[test]
+fn level_details_plot_the_resonance_point() {
+    let dir = scratch_dir("plot-details");
+    let files = plot_level_details(&dir, &levels(), PlotFormat::Svg).unwrap();
+    let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
+    assert_eq!(names.len(), 3 * 3);
+    assert_eq!(names[..3], ["harmonics_level0_mass.svg", "loop_level0_joint.svg", "slider_level0_joint.svg"]);
+    // Level 2 (k = 1.45e7 N/m, 10 kg, ζ = 0.06): the displacement FRF peaks at
+    // sqrt(k/m) sqrt(1 − 2ζ²)/2π = 190.96 Hz, so at 191 Hz on the 1 Hz grid.
+    let text = std::fs::read_to_string(dir.join("loop_level2_joint.svg")).unwrap();
+    assert!(text.contains("at 191.0000 Hz"), "the loop is not at the resonance");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

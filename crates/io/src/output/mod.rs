@@ -95,7 +95,8 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 
 /// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`, the
 /// time data of the points that carry it (`points/`), and one FRF plot per output
-/// (`frf_<out>.<png|svg>`). Returns the paths of the FRF table, the NPZ file and the plots.
+/// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`]. Returns the
+/// paths of the FRF table, the NPZ file and the plots.
 pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
@@ -104,6 +105,7 @@ pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat
     let mut files = vec![csv, npz];
     write_time_data(dir, levels)?;
     files.extend(crate::plot::plot_frfs(dir, levels, plot_format)?);
+    files.extend(crate::plot::plot_level_details(dir, levels, plot_format)?);
     Ok(files)
 }
 
