@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use stickslip_core::hbm::fourier::amplitude_phase;
-use stickslip_core::signal::frf::{frf_from_blocks, Normalization};
+use stickslip_core::signal::frf::{frf_from_blocks, identify_force, interpolate_at, Normalization};
 use stickslip_core::signal::harmonics::{extract, Block, SyncOptions};
 use stickslip_core::signal::period;
 use stickslip_io::records::{self, FrfCurve, FrfSet, TimeRecords};
@@ -50,8 +50,22 @@ pub struct Args {
     pub skip_cycles: usize,
     /// Excitation force amplitude in N (e.g. identified by Eq. 1): FRFs are the response divided
     /// by it. Default: divided by the reference channel's fundamental.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "calibration")]
     pub force_level: Option<f64>,
+    /// Identify the force level by paper Eq. 1 against a calibration: a harmonics table written by
+    /// `stickslip extract` for a record at a known level (--calibration-level), compared at an
+    /// off-resonance frequency (--identify-at) where the structure is linear.
+    #[arg(long, requires_all = ["calibration_level", "identify_at"])]
+    pub calibration: Option<PathBuf>,
+    /// Force level (N) of the calibration record (70 N in the paper).
+    #[arg(long)]
+    pub calibration_level: Option<f64>,
+    /// Frequency (Hz) of the identification, inside both records' ranges (100 Hz in the paper).
+    #[arg(long)]
+    pub identify_at: Option<f64>,
+    /// Response channel used for the identification (default: the first response).
+    #[arg(long)]
+    pub identify_channel: Option<String>,
     /// Also write the FRFs as UFF 58.
     #[arg(long, value_enum)]
     pub uff: Option<UffEncoding>,
@@ -135,9 +149,51 @@ fn harmonics_table(s: &Selected, blocks: &[(f64, &Block)], n: usize) -> (Vec<Str
     (columns, rows)
 }
 
+/// Amplitude of harmonic 1 at `frequency_hz` of a curve sampled in any order (a sweep may go down).
+fn amplitude_at(frequency_hz: &[f64], amplitude: &[f64], at_hz: f64) -> Result<f64> {
+    let mut pairs: Vec<(f64, f64)> = frequency_hz.iter().copied().zip(amplitude.iter().copied()).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (f, a): (Vec<f64>, Vec<f64>) = pairs.into_iter().unzip();
+    Ok(interpolate_at(&f, &a, at_hz)?)
+}
+
+/// Force level of `blocks` by paper Eq. 1, when a calibration is given.
+fn identified_level(s: &Selected, blocks: &[Block], args: &Args) -> Result<Option<f64>> {
+    let (Some(cal), Some(cal_level), Some(at)) = (&args.calibration, args.calibration_level, args.identify_at) else {
+        return Ok(None);
+    };
+    let r = match &args.identify_channel {
+        Some(name) => s
+            .responses
+            .iter()
+            .position(|c| c.name == *name || c.column() == *name)
+            .with_context(|| format!("--identify-channel `{name}` is not a response channel"))?,
+        None => 0,
+    };
+    let c = s.responses[r];
+    let f: Vec<f64> = blocks.iter().map(|b| b.frequency_hz).collect();
+    let a: Vec<f64> = blocks.iter().map(|b| b.harmonic(r, 1).norm()).collect();
+    let response = amplitude_at(&f, &a, at).with_context(|| format!("response `{}` at {at} Hz", c.name))?;
+    let table = records::read_table(cal)?;
+    let column = format!("{}_h1_amp_{}", c.name, c.unit);
+    let (Some(cf), Some(ca)) = (table.column("frequency_Hz"), table.column(&column)) else {
+        bail!(
+            "{}: no `frequency_Hz` and `{column}` columns (a harmonics table written by `stickslip extract`)",
+            cal.display()
+        );
+    };
+    let reference = amplitude_at(cf, ca, at).with_context(|| format!("calibration {} at {at} Hz", cal.display()))?;
+    let level = identify_force(cal_level, reference, response)?;
+    println!(
+        "force level {level:.4} N (Eq. 1: {cal_level} N x {response:.6e} / {reference:.6e} {} of `{}` at {at} Hz)",
+        c.unit, c.name
+    );
+    Ok(Some(level))
+}
+
 /// FRFs of every response over `blocks`, with the level and unit of the normalisation.
 fn frf_set(s: &Selected, blocks: &[Block], args: &Args, source: &str) -> Result<FrfSet> {
-    let (normalization, per, level_n) = match args.force_level {
+    let (normalization, per, level_n) = match args.force_level.or(identified_level(s, blocks, args)?) {
         Some(f) => (Normalization::Force { amplitude_n: f }, "N".to_string(), Some(f)),
         None => {
             // The reference's fundamental; as a force, its median amplitude is the level.
