@@ -205,7 +205,7 @@ impl<'m> Integrator<'m> {
         let c0 = 1.0 / (beta * step * step);
         let c1 = gamma / (beta * step);
         let operators = LinearOperators::new(lin)?;
-        let solver = effective_solver(lin, &operators, c0, (1.0 + alpha) * c1, 1.0 + alpha)?;
+        let mut solver = effective_solver(lin, &operators, c0, (1.0 + alpha) * c1, 1.0 + alpha)?;
         let q = model.n_directions();
         let dirs: Vec<f64> = model.application_vectors().flat_map(|v| v.iter().copied()).collect();
         let mut w = vec![0.0; q * n];
@@ -358,7 +358,7 @@ impl<'m> Integrator<'m> {
     fn initial_forces(&self, state: &mut State, load: &[f64], excitation: f64) -> Result<(), TimesimError> {
         let lin = &self.model.linear;
         let n = lin.n_dofs();
-        let mass = mass_solver(lin)?;
+        let mut mass = mass_solver(lin)?;
         for (e, site) in self.model.elements.iter().enumerate() {
             let (da, ds) = self.offsets[e];
             let (d, s) = (site.law.n_dirs(), site.law.n_state());

@@ -3,9 +3,12 @@
 
 use std::collections::HashMap;
 
-use faer::linalg::solvers::{DenseSolveCore, Solve};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::solvers::DenseSolveCore;
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, MatMut, Side};
+use faer::{Conj, Mat, MatMut, Par, Side};
 
 use super::TimesimError;
 use crate::model::{Damping, LinearModel, Matrix};
@@ -141,21 +144,23 @@ impl DampingOperator {
 pub(crate) enum SpdSolver {
     /// Explicit inverse (small models).
     DenseInverse(Mat<f64>),
-    Sparse(faer::sparse::linalg::solvers::Llt<usize, f64>),
+    /// Sparse Cholesky factor (AMD ordering) with its solve workspace allocated once, so that
+    /// a solve does not allocate.
+    Sparse { symbolic: Box<SymbolicCholesky<usize>>, values: Vec<f64>, workspace: MemBuffer },
 }
 
 impl std::fmt::Debug for SpdSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SpdSolver::DenseInverse(m) => write!(f, "SpdSolver::DenseInverse({}x{})", m.nrows(), m.ncols()),
-            SpdSolver::Sparse(_) => write!(f, "SpdSolver::Sparse"),
+            SpdSolver::Sparse { values, .. } => write!(f, "SpdSolver::Sparse({} factor values)", values.len()),
         }
     }
 }
 
 impl SpdSolver {
     /// `out = A⁻¹ rhs`.
-    pub(crate) fn solve(&self, rhs: &[f64], out: &mut [f64]) {
+    pub(crate) fn solve(&mut self, rhs: &[f64], out: &mut [f64]) {
         match self {
             SpdSolver::DenseInverse(inv) => {
                 out.iter_mut().for_each(|v| *v = 0.0);
@@ -167,10 +172,15 @@ impl SpdSolver {
                     }
                 }
             }
-            SpdSolver::Sparse(llt) => {
+            SpdSolver::Sparse { symbolic, values, workspace } => {
                 out.copy_from_slice(rhs);
                 let n = out.len();
-                llt.solve_in_place(MatMut::from_column_major_slice_mut(out, n, 1));
+                LltRef::new(symbolic, values).solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(out, n, 1),
+                    Par::Seq,
+                    MemStack::new(workspace),
+                );
             }
         }
     }
@@ -196,7 +206,27 @@ impl SpdSolver {
             let triplets: Vec<Triplet<usize, usize, f64>> =
                 sum.into_iter().map(|((i, j), v)| Triplet::new(i, j, v)).collect();
             let a = SparseColMat::try_new_from_triplets(n, n, &triplets).ok()?;
-            return a.sp_cholesky(Side::Lower).ok().map(SpdSolver::Sparse);
+            let symbolic =
+                factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, Default::default())
+                    .ok()?;
+            let mut values = vec![0.0; symbolic.len_val()];
+            let mut scratch =
+                MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+            // No regularisation: a non-positive pivot means S (or M) is not positive definite.
+            let exact = LltRegularization { dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
+            symbolic
+                .factorize_numeric_llt(
+                    &mut values,
+                    a.as_ref(),
+                    Side::Lower,
+                    exact,
+                    Par::Seq,
+                    MemStack::new(&mut scratch),
+                    Default::default(),
+                )
+                .ok()?;
+            let workspace = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+            return Some(SpdSolver::Sparse { symbolic: Box::new(symbolic), values, workspace });
         }
         let mut a = Mat::<f64>::zeros(n, n);
         for (c, m) in terms.iter().filter(|(c, _)| *c != 0.0) {
