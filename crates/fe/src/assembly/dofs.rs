@@ -65,12 +65,10 @@ impl DofMap {
                         wants(b, db);
                     }
                 }
-                PointElement::Connector { a, b, stiffness, .. } => {
-                    if stiffness[3..].iter().any(|k| *k != 0.0) {
-                        wants(a, 6);
-                        if let Some(b) = b {
-                            wants(b, 6);
-                        }
+                PointElement::Connector { a, b, stiffness, .. } if stiffness[3..].iter().any(|k| *k != 0.0) => {
+                    wants(a, 6);
+                    if let Some(b) = b {
+                        wants(b, 6);
                     }
                 }
                 _ => {}
@@ -190,8 +188,8 @@ impl DofMap {
         // Reduced numbering: independent free DOFs in node order.
         let mut reduced = vec![None; total];
         let mut independent = Vec::new();
-        for n in 0..nn {
-            for d in 1..=n_dirs[n] {
+        for (n, &dirs) in n_dirs.iter().enumerate() {
+            for d in 1..=dirs {
                 let p = full(n, d);
                 if matches!(status[p], Status::Free) {
                     reduced[p] = Some(independent.len() as u32);

@@ -187,6 +187,9 @@ fn solid_counts(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
         )
 }
 
+/// Contributions, volume and mass of one chunk of elements.
+type ChunkOutput = (Vec<Entry>, f64, f64);
+
 /// Upper-triangle contributions of all solids, computed in parallel over chunks of elements
 /// (a few chunks per thread at a time) and scattered into the builder; returns the volume and
 /// mass.
@@ -202,7 +205,7 @@ fn solid_entries(
     let batch = 2 * rayon::current_num_threads();
     let (mut volume, mut mass) = (0.0, 0.0);
     for group in chunks.chunks(batch) {
-        let results: Vec<Result<(Vec<Entry>, f64, f64), AssemblyError>> = group
+        let results: Vec<Result<ChunkOutput, AssemblyError>> = group
             .par_iter()
             .map(|chunk| {
                 let mut k = vec![0.0; 60 * 60];

@@ -75,13 +75,13 @@ pub fn box_mesh(lengths: [f64; 3], cells: [usize; 3], kind: SolidKind, material:
     let mut mesh = Mesh::default();
     let spacing = [0, 1, 2].map(|d| lengths[d] / (dims[d] - 1) as f64);
     let mut faces: [Vec<usize>; 6] = Default::default();
-    for p in 0..n_lattice {
-        if index[p] == usize::MAX {
+    for (p, slot) in index.iter_mut().enumerate() {
+        if *slot == usize::MAX {
             continue;
         }
         let ijk = [p % dims[0], (p / dims[0]) % dims[1], p / (dims[0] * dims[1])];
         let n = mesh.add_node(mesh.nodes.len() as u64 + 1, [0, 1, 2].map(|d| ijk[d] as f64 * spacing[d])).unwrap();
-        index[p] = n;
+        *slot = n;
         for d in 0..3 {
             if ijk[d] == 0 {
                 faces[2 * d].push(n);

@@ -358,7 +358,8 @@ impl Parser {
                 }
                 let e = self.float(l, f[0], "Young's modulus")?;
                 let nu = self.float(l, f[1], "Poisson's ratio")?;
-                if !(e > 0.0) || !(-1.0 < nu && nu < 0.5) {
+                // Written so that NaN fails too.
+                if !(e > 0.0 && -1.0 < nu && nu < 0.5) {
                     return Err(self.syntax(l, format!("need E > 0 and -1 < nu < 0.5, got E = {e}, nu = {nu}")));
                 }
                 self.mesh.materials[m].1.young = e;
@@ -369,7 +370,7 @@ impl Parser {
                 let l = nonblank.first().ok_or_else(|| self.syntax(kw, "*DENSITY needs a line: rho"))?;
                 let f: Vec<&str> = fields(&l.text).collect();
                 let rho = self.float(l, f.first().copied().unwrap_or(""), "a density")?;
-                if !(rho > 0.0) {
+                if rho.is_nan() || rho <= 0.0 {
                     return Err(self.syntax(l, format!("need a density > 0, got {rho}")));
                 }
                 self.mesh.materials[m].1.density = rho;
@@ -417,7 +418,7 @@ impl Parser {
                         let l =
                             nonblank.get(k).ok_or_else(|| self.syntax(kw, "*EQUATION: fewer terms than announced"))?;
                         let f: Vec<&str> = fields(&l.text).collect();
-                        if f.len() % 3 != 0 || f.is_empty() {
+                        if !f.len().is_multiple_of(3) || f.is_empty() {
                             return Err(self.syntax(l, "expected terms node, DOF, coefficient"));
                         }
                         for t in f.chunks(3) {
