@@ -47,6 +47,65 @@ def matrices():
     return m, k, ALPHA * m
 
 
+def write_study(folder):
+    """Write the same model as a stickslip study (Matrix Market M and K, DOF names, study.toml),
+    so that both codes run the identical case."""
+    os.makedirs(folder, exist_ok=True)
+    m, k, _ = matrices()
+    for name, a in (("mass.mtx", m), ("stiffness.mtx", k)):
+        rows = [(i, j, a[i, j]) for j in range(N_DOF) for i in range(j, N_DOF) if a[i, j] != 0.0]
+        with open(os.path.join(folder, name), "w") as f:
+            f.write("%%MatrixMarket matrix coordinate real symmetric\n")
+            f.write(f"{N_DOF} {N_DOF} {len(rows)}\n")
+            f.writelines(f"{i + 1} {j + 1} {v:.17g}\n" for i, j, v in rows)
+    with open(os.path.join(folder, "dofs.txt"), "w") as f:
+        f.writelines(f"u{i}\n" for i in range(N_DOF))
+    n = len(CONTACTS)
+    joints = "".join(
+        f'''
+[[joint]]
+name = "contact{c}"
+law = "jenkins"
+dof = "u{c}"                # between u{c} and the ground
+stiffness = {K_JENKINS / n!r}    # N/m, k_jenkins / 4
+replaces_stiffness = false  # in parallel with K, which holds (k - k_jenkins) / 4 here
+threshold = {F_COULOMB / n!r}       # N, F_c / 4
+'''
+        for c in CONTACTS
+    )
+    study = f'''# 137-DOF stand-in for the paper-size case, as timed with pyHarm (bench/peer/pyharm_paper.py).
+[model]
+mass_file = "mass.mtx"
+stiffness_file = "stiffness.mtx"
+dof_file = "dofs.txt"
+
+[damping]
+alpha = {ALPHA!r}               # 1/s, D = alpha M
+
+[[load]]
+name = "force"
+dof = "u{FORCE_DOF}"
+{joints}
+[excitation]
+load = "force"
+levels = [{F_EXCIT!r}]
+
+[sweep]
+start_hz = {BAND_HZ[0]!r}
+end_hz = {BAND_HZ[1]!r}
+
+[harmonic_balance]
+harmonics = {HARMONICS}
+samples = {SAMPLES}
+
+[[output]]
+name = "forced"
+dof = "u{FORCE_DOF}"
+'''
+    with open(os.path.join(folder, "study.toml"), "w") as f:
+        f.write(study)
+
+
 def system_input(band_hz, ds, solver, reductor, max_points=None):
     m, k, d = matrices()
     n = len(CONTACTS)
@@ -62,10 +121,14 @@ if __name__ == "__main__":
         "pyHarm sweep at the paper's size: 137 DOFs, 4 Jenkins elements",
         os.path.join(HERE, "results", "pyharm_paper_frf.csv"),
         default_ds=0.02,
-        default_reductor="NLdofs",
+        default_reductor="noreductor",
     )
     p.add_argument("--band", type=float, nargs=2, default=list(BAND_HZ), help="sweep band, Hz")
+    p.add_argument("--write-study", metavar="DIR", help="only write the model as a stickslip study into DIR")
     args = p.parse_args()
+    if args.write_study:
+        write_study(args.write_study)
+        raise SystemExit(0)
     band = tuple(args.band)
     inp = system_input(band, args.ds, args.solver, args.reductor, args.max_points)
     # Warm-up on 3 solutions: it compiles the same numba kernels at a fraction of a full sweep.

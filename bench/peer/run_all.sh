@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Runs every pyHarm peer measurement and keeps the printed reports in results/.
+# Needs pyHarm in a throwaway virtualenv (not a project dependency):
+#   python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install pyharm-os==1.2.2
+# Usage: bash bench/peer/run_all.sh [PYTHON]   (takes about 40 minutes on the 2-core machine)
+set -euo pipefail
+cd "$(dirname "$0")"
+PY=${1:-/tmp/pyharm-venv/bin/python}
+ONE="env OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 taskset -c 0"
+mkdir -p results
+
+# Table 6 1-DOF, 150-350 Hz: one core, then the default (all cores, default BLAS threads).
+$ONE "$PY" pyharm_table6.py > results/table6_one_core.txt
+"$PY" pyharm_table6.py --csv /tmp/pyharm_table6_default.csv > results/table6_default_threads.txt
+# Same sweep with pyHarm's plain Newton-Raphson solver (iterations = Newton iterations).
+$ONE "$PY" pyharm_table6.py --solver NewtonRaphson --csv results/pyharm_table6_newton_frf.csv \
+    > results/table6_one_core_newton.txt
+
+# 10-DOF chain, 20-35 Hz: full harmonic system and pyHarm's condensation onto the Jenkins DOFs.
+$ONE "$PY" pyharm_chain.py > results/chain_one_core.txt
+$ONE "$PY" pyharm_chain.py --reductor NLdofs --csv /tmp/pyharm_chain_condensed.csv \
+    > results/chain_one_core_condensed.txt
+"$PY" pyharm_chain.py --runs 3 --csv /tmp/pyharm_chain_default.csv > results/chain_default_threads.txt
+
+# 137 DOFs: a whole sweep takes hours, so time the first 10 continuation points, once, from the
+# band's lower end (stuck) and from 200 Hz (slipping, near the peak).
+$ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 10 \
+    > results/paper_one_core_from170.txt
+$ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 10 --band 200 300 \
+    --csv results/pyharm_paper_frf_from200.csv > results/paper_one_core_from200.txt
+$ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 5 --band 200 300 --reductor NLdofs \
+    --csv /tmp/pyharm_paper_condensed.csv > results/paper_one_core_from200_condensed.txt
