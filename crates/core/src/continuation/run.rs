@@ -566,3 +566,73 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         true
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::MatMut;
+
+    /// x² + λ² = 1.
+    struct Circle;
+
+    impl Problem for Circle {
+        fn dimension(&self) -> usize {
+            1
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            lambda: f64,
+            residual: &mut [f64],
+            jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+        ) -> Result<(), ProblemError> {
+            residual[0] = x[0] * x[0] + lambda * lambda - 1.0;
+            if let Some((mut jx, dl)) = jacobian {
+                jx[(0, 0)] = 2.0 * x[0];
+                dl[0] = 2.0 * lambda;
+            }
+            Ok(())
+        }
+    }
+
+    fn point(x: f64, lambda: f64) -> Point {
+        Point { x: vec![x], lambda, iterations: 0, residual_norm: 0.0, step: 0.0, rejected: 0, calls: Calls::default() }
+    }
+
+    #[test]
+    fn tangent_is_the_null_vector_of_the_jacobian_in_scaled_variables() {
+        let options = Options::default();
+        let mut circle = Circle;
+        let mut runner = Runner::new(&mut circle, &options, 0.0, 2.0);
+        runner.scale = Scaling { x: 3.0, lambda: 2.0, residual: 1.0, x_fixed: true };
+        let (x, lambda) = (0.6, 0.8);
+        runner.x_phys[0] = x;
+        runner.evaluate(lambda, true).unwrap();
+        runner.reference.copy_from_slice(&[0.0, 1.0]);
+        assert!(runner.tangent_at_last_point());
+        // Physical tangent of the circle at (x, λ): (dx, dλ) ∝ (−λ, x); scaled: (−λ/s_x, x/s_λ).
+        let (u, m) = (-lambda / 3.0, x / 2.0);
+        let length = u.hypot(m);
+        // Unit length and orientation along the reference (dλ > 0); exact to rounding.
+        assert!((runner.tangent[0] - u / length).abs() < 1e-15, "{:?}", runner.tangent);
+        assert!((runner.tangent[1] - m / length).abs() < 1e-15, "{:?}", runner.tangent);
+    }
+
+    #[test]
+    fn lagrange_prediction_continues_collinear_points_by_exactly_the_step() {
+        // Three points on a line with uneven spacing: the quadratic in the chord length
+        // reproduces the line, so the prediction lies on it at distance h from the last point.
+        let options = Options { predictor: Predictor::Lagrange, ..Options::default() };
+        let mut circle = Circle;
+        let mut runner = Runner::new(&mut circle, &options, 0.0, 1.0);
+        runner.scale = Scaling { x: 1.0, lambda: 1.0, residual: 1.0, x_fixed: true };
+        let line = |s: f64| point(0.1 + 0.6 * s, 0.2 + 0.8 * s);
+        let points = [line(0.0), line(0.05), line(0.2)];
+        let h = 0.07;
+        runner.predict(&points, h);
+        let expected = line(0.2 + h);
+        assert!((runner.z_pred[0] - expected.x[0]).abs() < 1e-15, "{:?}", runner.z_pred);
+        assert!((runner.z_pred[1] - expected.lambda).abs() < 1e-15, "{:?}", runner.z_pred);
+        assert!((runner.t[0] - 0.6).abs() < 1e-14 && (runner.t[1] - 0.8).abs() < 1e-14, "{:?}", runner.t);
+    }
+}
