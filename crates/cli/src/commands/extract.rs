@@ -73,6 +73,10 @@ pub struct Args {
     /// "video"), written to OUT/frames/.
     #[arg(long)]
     pub frames: Option<usize>,
+    /// Frames of the time integral of the responses (vibrometer velocities → displacements, as
+    /// in the paper's Fig. 22); the mean is set to zero.
+    #[arg(long, requires = "frames")]
+    pub integrate: bool,
 }
 
 /// Read time records from CSV or UFF (by extension), reporting what UFF reading skipped.
@@ -290,9 +294,10 @@ pub fn main(args: Args) -> Result<()> {
                 _ => {}
             }
             let block = blocks_of(r, &s, &options)?.remove(0);
+            let omega = 2.0 * std::f64::consts::PI * block.frequency_hz;
             for (c, x) in s.responses.iter().zip(&block.responses) {
                 point_names.push(format!("{}.{}", stem(path), c.name));
-                coeffs.push(x.clone());
+                coeffs.push(if args.integrate { period::integrate(x, omega)? } else { x.clone() });
             }
             all.push((r.start_s + 0.5 * (block.start_s + block.end_s), block));
         }
@@ -309,7 +314,12 @@ pub fn main(args: Args) -> Result<()> {
         written.extend(write_frfs(&args.out, "frf", &set, &args)?);
         if let Some(n_frames) = args.frames {
             let frames = period::frames(&coeffs, n_frames)?;
-            let unit = &s.responses[0].unit;
+            let unit = match (args.integrate, s.responses[0].unit.as_str()) {
+                (false, u) => u.to_string(),
+                (true, "m_s2") => "m_s".into(),
+                (true, "m_s") => "m".into(),
+                (true, u) => format!("{u}_s"),
+            };
             let files =
                 records::write_frames(&args.out.join("frames"), &point_names, &format!("value_{unit}"), &frames)?;
             println!("{} frames of {} points in {}", files.len(), point_names.len(), args.out.join("frames").display());

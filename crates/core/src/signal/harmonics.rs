@@ -27,7 +27,8 @@ use crate::hbm::fourier::{basis, cos_index, sin_index};
 pub struct SyncOptions {
     /// Highest harmonic N extracted (≥ 1).
     pub n_harmonics: usize,
-    /// Reference cycles per block; `usize::MAX` puts all remaining cycles in one block.
+    /// Reference cycles per block; `usize::MAX` puts all remaining cycles in one block. An
+    /// incomplete last block is dropped (all blocks average the same number of cycles).
     pub cycles_per_block: usize,
     /// Cycles dropped at the start of the record (transient).
     pub skip_cycles: usize,
