@@ -140,6 +140,21 @@ impl FeModel {
     }
 }
 
+impl FeModel {
+    /// Write the solids and one displacement field per model vector (e.g. mode shapes, named
+    /// with their frequency) as a VTK legacy unstructured grid.
+    pub fn write_vtk(
+        &self,
+        out: &mut impl std::io::Write,
+        title: &str,
+        shapes: &[(String, Vec<f64>)],
+    ) -> std::io::Result<()> {
+        let fields: Vec<(String, Vec<[f64; 3]>)> =
+            shapes.iter().map(|(name, q)| (name.clone(), self.nodal_displacements(q))).collect();
+        crate::mesh::vtk::write(out, title, &self.mesh.nodes, &self.mesh.solids, &fields)
+    }
+}
+
 /// Elements per parallel work unit: large enough to amortise the scheduling, small enough to
 /// balance the threads and keep each unit's contributions (~10 MB for tet10) in cache-sized
 /// buffers.
