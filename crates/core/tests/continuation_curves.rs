@@ -199,6 +199,8 @@ fn steps_halve_down_to_min_step_before_a_wall() {
     }
     match branch.termination {
         TerminationReason::StepTooSmall { lambda, attempts, residual_norm, .. } => {
+            let message = branch.termination.to_string();
+            assert!(message.contains(&format!("{attempts} steps tried")), "{message}");
             assert_eq!(lambda, last.lambda);
             assert_eq!(attempts, expected_attempts);
             assert!(residual_norm.is_nan());
@@ -225,6 +227,8 @@ fn a_problem_error_ends_the_branch_with_where_it_happened_and_keeps_the_points()
         }
         other => panic!("expected ProblemError, got {other:?}"),
     }
+    let message = branch.termination.to_string();
+    assert!(message.contains(&format!("last converged point at λ = {last}")), "{message}");
     assert!(last <= 0.6 && last > 0.5, "points up to the failure are kept, last at {last}");
     assert!(branch.points.iter().all(|p| (p.x[0] - p.lambda).abs() <= 1e-10)); // Newton tolerance
 }

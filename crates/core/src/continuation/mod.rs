@@ -288,6 +288,33 @@ pub enum TerminationReason {
     },
 }
 
+impl std::fmt::Display for TerminationReason {
+    /// One sentence saying where and why the branch ended (λ in the problem's units).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TerminationReason::ReachedEnd => write!(f, "reached the end of the interval"),
+            TerminationReason::ReturnedToStart => write!(f, "came back to the start of the interval after a fold"),
+            TerminationReason::MaxPoints => write!(f, "stopped at the maximum number of points"),
+            TerminationReason::FirstPointFailed { lambda, residual_norm, iterations } => write!(
+                f,
+                "no solution found at the start λ = {lambda}: Newton from the initial guess ended at residual \
+                 {residual_norm:.3e} after {iterations} iterations"
+            ),
+            TerminationReason::StepTooSmall { lambda, residual_norm, attempts, iterations } => write!(
+                f,
+                "no convergence after the point at λ = {lambda}: {attempts} steps tried, each half the previous \
+                 ({iterations} Newton iterations), down to the minimum step; last residual {residual_norm:.3e}"
+            ),
+            TerminationReason::ProblemError { lambda, last_lambda, error } => match last_lambda {
+                Some(last) => {
+                    write!(f, "the problem failed at λ = {lambda} (last converged point at λ = {last}): {error}")
+                }
+                None => write!(f, "the problem failed at λ = {lambda}, before any point converged: {error}"),
+            },
+        }
+    }
+}
+
 /// A continued solution branch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Branch {
