@@ -87,9 +87,8 @@ fn two_rigid_bodies_joined_by_a_stiff_connector_move_as_one() {
     let total = 2.0 * STEEL.density * 0.2 * 0.1 * 0.1;
     let f = element_support::dense_frequencies(&fe.model);
     let expected = hz(kz / total);
-    // The z mode couples weakly to the rotations through the offset of the two bodies (none:
-    // both centroids lie on the x axis through r1, so z translation is a principal motion);
-    // the 1e10 connector's flexibility shifts it by ~k/1e10 ≈ 1e-6 relative.
+    // Both centroids lie on the line through r1 along x, so the z translation of the pair is
+    // a principal motion on k_z; the 1e10 N/m connector's flexibility shifts it by ~k_z/1e10.
     let closest =
         f.iter().copied().min_by(|a, b| (a - expected).abs().partial_cmp(&(b - expected).abs()).unwrap()).unwrap();
     println!("z mode {closest:.6} Hz, rigid-assembly value {expected:.6} Hz");
@@ -185,4 +184,26 @@ fn kinematic_coupling_keywords_build_the_same_model() {
     }
     // Node 2 keeps u_x; node 1 is fixed; nodes 3, 4 follow the reference node's 6 DOFs.
     assert_eq!(models[0].model.n_dofs(), 7);
+}
+
+#[test]
+fn element_face_surfaces_collect_corner_and_mid_edge_nodes() {
+    // A C3D10 and a C3D20 in one deck; face S1 of each, coupled to reference nodes.
+    let deck = "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n5, .5, 0., 0.\n6, .5, .5, 0.\n\
+                7, 0., .5, 0.\n8, 0., 0., .5\n9, .5, 0., .5\n10, 0., .5, .5\n100, .2, .2, 0.\n\
+                *ELEMENT, TYPE=C3D10, ELSET=E\n1, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10\n\
+                *SURFACE, NAME=BOTTOM\nE, S1\n*COUPLING, REF NODE=100, SURFACE=BOTTOM, CONSTRAINT NAME=C\n*KINEMATIC\n1, 3\n\
+                *MATERIAL, NAME=S\n*ELASTIC\n1e9, 0.3\n*DENSITY\n1000.\n*SOLID SECTION, ELSET=E, MATERIAL=S\n";
+    let mesh = inp::parse(deck, "faces.inp").unwrap();
+    // S1 of a tetrahedron is the face of nodes 1-2-3 and its mid-edge nodes 5, 6, 7.
+    let ids: Vec<u64> = mesh.couplings[0].nodes.iter().map(|&n| mesh.nodes[n].id).collect();
+    assert_eq!(ids, vec![1, 2, 3, 5, 6, 7]);
+    assert_eq!(mesh.node_set("bottom").unwrap().len(), 6);
+    let fe = FeModel::assemble(mesh).unwrap();
+    // Free: node 4, 8, 9, 10 (3 DOFs each) and the reference node (6).
+    assert_eq!(fe.model.n_dofs(), 4 * 3 + 6);
+    let hex = stickslip_fe::mesh::inp::face_local_nodes(SolidKind::Hex20, 3).unwrap();
+    // S3 of a hexahedron: corners 1-5-6-2 (0-based 0, 4, 5, 1) and the mid-edge nodes of its
+    // edges (0,1), (4,5), (0,4), (1,5).
+    assert_eq!(hex, vec![0, 4, 5, 1, 8, 12, 16, 17]);
 }

@@ -1,7 +1,6 @@
 //! Mode shapes written as VTK legacy files: read back, the file holds the mesh and the
 //! nodal displacements of each mode.
 
-
 use stickslip_fe::assembly::FeModel;
 use stickslip_fe::element::SolidKind;
 use stickslip_fe::mesh::generate::box_mesh;
