@@ -228,7 +228,8 @@ pub struct Calls {
     pub residuals: usize,
     /// Jacobian evaluations.
     pub jacobians: usize,
-    /// LU factorisations.
+    /// LU factorisations: one per Newton iteration, plus the tangent at the previous point
+    /// (the first point's, and every point's with the tangent predictor).
     pub factorizations: usize,
 }
 
