@@ -249,6 +249,21 @@ fn a_start_without_solution_ends_the_branch_with_no_points_and_the_reason() {
 }
 
 #[test]
+fn a_problem_failing_at_the_start_is_reported_with_no_points() {
+    let mut line = Line::new();
+    line.error_above = -1.0;
+    let branch = run(&mut line, 0.0, 0.0, 1.0, &Options::default());
+    assert!(branch.points.is_empty());
+    match &branch.termination {
+        TerminationReason::ProblemError { lambda, last_lambda, .. } => {
+            assert_eq!((*lambda, *last_lambda), (0.0, None));
+        }
+        other => panic!("expected ProblemError, got {other:?}"),
+    }
+    assert!(branch.termination.to_string().contains("before any point converged"));
+}
+
+#[test]
 fn invalid_input_is_an_error_naming_what_is_wrong() {
     let bad = Options { max_step: 1e-9, ..Options::default() };
     let err = continue_branch(&mut Circle, &[1.0], 0.0, 1.0, &bad, &mut Silent).unwrap_err();
