@@ -9,6 +9,10 @@ use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, ModelError, NamedVector,
     NonlinearModel,
 };
+use stickslip_fe::assembly::FeModel;
+use stickslip_fe::eigen::EigenOptions;
+use stickslip_fe::mesh::Material;
+use stickslip_fe::reduction::{self, Reduction, ReductionOptions, Release};
 
 use super::*;
 
@@ -42,73 +46,38 @@ impl Study {
             location: Some(at),
             kind: Box::new(kind),
         };
-        let (mass, stiffness, dofs, model_at) = match &self.model {
-            ModelSpec::Inline { dofs, mass, stiffness, at } => (
-                Matrix::Dense(mass.clone()),
-                Matrix::Dense(stiffness.clone()),
-                dofs.iter().map(|d| dof_label(d)).collect::<Vec<_>>(),
-                *at,
-            ),
-            ModelSpec::Files { mass, stiffness, dofs, at } => {
-                let m = read_matrix(mass, "[model] mass_file").map_err(|k| err(at.mass, k))?;
-                let k = read_matrix(stiffness, "[model] stiffness_file").map_err(|k| err(at.stiffness, k))?;
-                let labels = match dofs {
-                    DofNames::Numbered => (1..=m.nrows()).map(|i| DofLabel::named(i.to_string())).collect(),
-                    DofNames::Inline(names) => names.iter().map(|d| dof_label(d)).collect(),
-                    DofNames::File(path) => read_dof_file(path).map_err(|k| err(at.section, k))?,
-                };
-                (m, k, labels, *at)
-            }
-        };
-        let damping = match &self.damping {
-            DampingSpec::None => Damping::None,
-            DampingSpec::Rayleigh { alpha, beta } => Damping::Rayleigh { alpha: *alpha, beta: *beta },
-            DampingSpec::Modal { ratios } => Damping::Modal { ratios: ratios.clone() },
-            DampingSpec::Matrix(d) => Damping::Matrix(Matrix::Dense(d.clone())),
-            DampingSpec::File(path) => {
-                Damping::Matrix(read_matrix(path, "[model] damping_file").map_err(|k| err(model_at.section, k))?)
-            }
-        };
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
-        // Point at the matrix a model error is about.
-        let model_error_at = |e: &ModelError| match e {
-            ModelError::MassNotPositiveDefinite => model_at.mass,
-            ModelError::WrongSize { what, .. }
-            | ModelError::NotSymmetric { what, .. }
-            | ModelError::NotFinite { what }
-                if what.starts_with('M') =>
-            {
-                model_at.mass
+        let (full, fe, model_at) = self.full_model()?;
+        // Reduction (Section 3.3): the nonlinear analysis runs on the reduced model; loads,
+        // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
+        // u = Vᵀ U = (Tᵀ V)ᵀ q).
+        let full_dofs = full.dofs.clone();
+        let (mut linear, reduction) = match &self.reduction {
+            None => (full, None),
+            Some(r) => {
+                let releases = self.releases(&full)?;
+                let red = reduce(&full, fe.as_ref(), r, &releases).map_err(|k| err(r.at, k))?;
+                (red.model.clone(), Some(red))
             }
-            ModelError::WrongSize { what, .. }
-            | ModelError::NotSymmetric { what, .. }
-            | ModelError::NotFinite { what }
-                if what.starts_with('K') =>
-            {
-                model_at.stiffness
-            }
-            _ => model_at.section,
         };
-        let mut linear = LinearModel::new(mass, stiffness, damping, dofs, Vec::new())
-            .map_err(|e| err(model_error_at(&e), model_error(e)))?;
-        check_mass_positive_definite(&linear.mass).map_err(|e| err(model_error_at(&e), model_error(e)))?;
+        let space = DofSpace { dofs: &full_dofs, reduction: reduction.as_ref() };
 
         for l in &self.loads {
             let ctx = format!("[[load]] {:?}", l.name);
-            let v = vector(&linear, &l.placement, &ctx).map_err(|k| err(l.at, k))?;
+            let v = vector(&space, &l.placement, &ctx).map_err(|k| err(l.at, k))?;
             linear.loads.push(NamedVector { name: l.name.clone(), values: v.iter().map(|x| x * l.scale).collect() });
         }
 
         let mut sites = Vec::with_capacity(self.joints.len());
         let mut replaced = Vec::new();
         for j in &self.joints {
-            let (site, replaced_k) = self.joint_site(&linear, j).map_err(|k| err(j.at, k))?;
+            let (site, replaced_k) = self.joint_site(&linear, &space, j).map_err(|k| err(j.at, k))?;
             if let Some(k) = replaced_k {
                 replaced.push((j, k, site.directions[0].clone()));
             }
             sites.push(site);
         }
-        check_slipped_stiffness(&linear, &replaced).map_err(|(j, k)| err(j.at, k))?;
+        check_slipped_stiffness(&linear, &replaced).map_err(|(at, m)| err(at, StudyErrorKind::Invalid(m)))?;
 
         let load_name = match &self.excitation.load {
             Some(name) => name.clone(),
@@ -138,7 +107,7 @@ impl Study {
             let mut outs = Vec::with_capacity(self.outputs.len());
             for o in &self.outputs {
                 let ctx = format!("[[output]] {:?}", o.name);
-                let v = vector(&linear, &o.placement, &ctx).map_err(|k| err(o.at, k))?;
+                let v = vector(&space, &o.placement, &ctx).map_err(|k| err(o.at, k))?;
                 outs.push(OutputSpec { name: o.name.clone(), vector: v });
             }
             outs
@@ -148,20 +117,115 @@ impl Study {
         Ok((model, excitation, outputs))
     }
 
+    /// The model as given (before any reduction), checked: M positive definite; inline and
+    /// file models also for sizes and symmetry (assembled meshes are symmetric by construction).
+    fn full_model(&self) -> Result<(LinearModel, Option<FeModel>, ModelLocations), StudyError> {
+        let err = |at: Location, kind: StudyErrorKind| StudyError {
+            file: self.path.clone(),
+            location: Some(at),
+            kind: Box::new(kind),
+        };
+        let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
+        let damping = |at: Location| -> Result<Damping, StudyError> {
+            Ok(match &self.damping {
+                DampingSpec::None => Damping::None,
+                DampingSpec::Rayleigh { alpha, beta } => Damping::Rayleigh { alpha: *alpha, beta: *beta },
+                DampingSpec::Modal { ratios } => Damping::Modal { ratios: ratios.clone() },
+                DampingSpec::Matrix(d) => Damping::Matrix(Matrix::Dense(d.clone())),
+                DampingSpec::File(path) => {
+                    Damping::Matrix(read_matrix(path, "[model] damping_file").map_err(|k| err(at, k))?)
+                }
+            })
+        };
+        let (mass, stiffness, dofs, at) = match &self.model {
+            ModelSpec::Inline { dofs, mass, stiffness, at } => (
+                Matrix::Dense(mass.clone()),
+                Matrix::Dense(stiffness.clone()),
+                dofs.iter().map(|d| dof_label(d)).collect::<Vec<_>>(),
+                *at,
+            ),
+            ModelSpec::Files { mass, stiffness, dofs, at } => {
+                let m = read_matrix(mass, "[model] mass_file").map_err(|k| err(at.mass, k))?;
+                let k = read_matrix(stiffness, "[model] stiffness_file").map_err(|k| err(at.stiffness, k))?;
+                let labels = match dofs {
+                    DofNames::Numbered => (1..=m.nrows()).map(|i| DofLabel::named(i.to_string())).collect(),
+                    DofNames::Inline(names) => names.iter().map(|d| dof_label(d)).collect(),
+                    DofNames::File(path) => read_dof_file(path).map_err(|k| err(at.section, k))?,
+                };
+                (m, k, labels, *at)
+            }
+            ModelSpec::Mesh { path, material, at } => {
+                let mut fe = read_mesh(path, material.as_ref()).map_err(|k| err(at.mass, k))?;
+                fe.model.damping = damping(at.section)?;
+                check_mass_positive_definite(&fe.model.mass).map_err(|e| err(at.mass, model_error(e)))?;
+                let model = fe.model.clone();
+                return Ok((model, Some(fe), *at));
+            }
+        };
+        // Point at the matrix a model error is about.
+        let error_at = |e: &ModelError| match e {
+            ModelError::MassNotPositiveDefinite => at.mass,
+            ModelError::WrongSize { what, .. }
+            | ModelError::NotSymmetric { what, .. }
+            | ModelError::NotFinite { what }
+                if what.starts_with('M') =>
+            {
+                at.mass
+            }
+            ModelError::WrongSize { what, .. }
+            | ModelError::NotSymmetric { what, .. }
+            | ModelError::NotFinite { what }
+                if what.starts_with('K') =>
+            {
+                at.stiffness
+            }
+            _ => at.section,
+        };
+        let linear = LinearModel::new(mass, stiffness, damping(at.section)?, dofs, Vec::new())
+            .map_err(|e| err(error_at(&e), model_error(e)))?;
+        check_mass_positive_definite(&linear.mass).map_err(|e| err(error_at(&e), model_error(e)))?;
+        Ok((linear, None, at))
+    }
+
+    /// The joints that replace stiffness of the full model, as releases for the enriched
+    /// reduction (their connector `k d dᵀ` removed from K).
+    fn releases(&self, full: &LinearModel) -> Result<Vec<Release>, StudyError> {
+        let err = |at: Location, kind: StudyErrorKind| StudyError {
+            file: self.path.clone(),
+            location: Some(at),
+            kind: Box::new(kind),
+        };
+        let space = DofSpace { dofs: &full.dofs, reduction: None };
+        let mut out = Vec::new();
+        for j in &self.joints {
+            let stiffness = match &j.law {
+                LawSpec::Jenkins { stiffness, .. } | LawSpec::Iwan { stiffness, .. } => *stiffness,
+                _ => continue,
+            };
+            let ctx = format!("[[joint]] {:?}", j.name);
+            let mut v = full_vector(&space, &j.placement, &ctx).map_err(|k| err(j.at, k))?;
+            normalise_user_vector(&mut v, &j.placement, &ctx).map_err(|k| err(j.at, k))?;
+            let k = match stiffness {
+                JointStiffness::Own(_) => continue,
+                JointStiffness::Replaces(k) => k,
+                JointStiffness::ReplacesComputed => replaced_stiffness(full, &v),
+            };
+            out.push(Release { name: j.name.clone(), direction: v, stiffness: k });
+        }
+        Ok(out)
+    }
+
     /// The element of one joint on its application vector, and the stiffness it replaces in K
     /// (paper form, Eq. 11), if any.
-    fn joint_site(&self, linear: &LinearModel, j: &JointSpec) -> Result<(ElementSite, Option<f64>), StudyErrorKind> {
+    fn joint_site(
+        &self,
+        linear: &LinearModel,
+        space: &DofSpace,
+        j: &JointSpec,
+    ) -> Result<(ElementSite, Option<f64>), StudyErrorKind> {
         let ctx = format!("[[joint]] {:?}", j.name);
-        let mut v = vector(linear, &j.placement, &ctx)?;
-        if let Placement::Vector(_) = j.placement {
-            // The paper normalises the application vector (Section 3.4): the threshold is then a
-            // force along a unit direction.
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm == 0.0 {
-                return Err(StudyErrorKind::Invalid(format!("{ctx}: vector is zero")));
-            }
-            v.iter_mut().for_each(|x| *x /= norm);
-        }
+        let mut v = vector(space, &j.placement, &ctx)?;
+        normalise_user_vector(&mut v, &j.placement, &ctx)?;
         let element_error = |source| StudyErrorKind::Element { context: ctx.clone(), source };
         // Paper Eq. 7: the stuck stiffness seen along V; it must be positive to be replaced.
         let stuck = |s: JointStiffness| -> Result<(f64, bool), StudyErrorKind> {
@@ -169,11 +233,7 @@ impl Study {
                 JointStiffness::Own(k) => Ok((k, false)),
                 JointStiffness::Replaces(k) => Ok((k, true)),
                 JointStiffness::ReplacesComputed => {
-                    // Eq. 7 is written for a unit vector: k_n = V_nᵀ K V_n with V_n = V/|V|. The
-                    // element sees u = Vᵀ U = |V| u_n, so the same energy needs k = k_n / |V|²
-                    // (for `between`, |V|² = 2; for `dof` and normalised vectors, 1).
-                    let norm2: f64 = v.iter().map(|x| x * x).sum();
-                    let k = stiffness_along(linear, &v) / (norm2 * norm2);
+                    let k = replaced_stiffness(linear, &v);
                     if k > 0.0 {
                         Ok((k, true))
                     } else {
@@ -214,10 +274,10 @@ const MAX_SLIPPED_CHECK_DOFS: usize = 3000;
 /// Joints that replace part of K (paper Eq. 11) leave `K − Σ k_e V_e V_eᵀ` when they all slip.
 /// It must stay positive semi-definite: a joint cannot remove more stiffness than the model
 /// has along its direction (the slipped structure would have a negative stiffness).
-fn check_slipped_stiffness<'a>(
+fn check_slipped_stiffness(
     linear: &LinearModel,
-    replaced: &[(&'a JointSpec, f64, Vec<f64>)],
-) -> Result<(), (&'a JointSpec, StudyErrorKind)> {
+    replaced: &[(&JointSpec, f64, Vec<f64>)],
+) -> Result<(), (Location, String)> {
     let n = linear.n_dofs();
     if replaced.is_empty() || n > MAX_SLIPPED_CHECK_DOFS {
         return Ok(());
@@ -238,32 +298,139 @@ fn check_slipped_stiffness<'a>(
     if lowest < -1e-9 * scale {
         let names: Vec<String> = replaced.iter().map(|(j, k, _)| format!("{:?} ({k:e} N/m)", j.name)).collect();
         return Err((
-            replaced[0].0,
-            StudyErrorKind::Invalid(format!(
+            replaced[0].0.at,
+            format!(
                 "[[joint]] {:?}: with the joints {} slipping, the stiffness left, K − Σ k V Vᵀ, has a negative eigenvalue ({lowest:.3e} N/m): they replace more stiffness than the model has along their directions; give each the part of K it replaces with `stiffness`, or make it a separate element with replaces_stiffness = false",
                 replaced[0].0.name,
                 names.join(", ")
-            )),
+            ),
         ));
     }
     Ok(())
 }
 
-/// The vector over the model's DOFs that a placement stands for.
-fn vector(linear: &LinearModel, p: &Placement, ctx: &str) -> Result<Vec<f64>, StudyErrorKind> {
-    let n = linear.n_dofs();
-    let index = |name: &str| {
-        linear.dof_index(name).map_err(|source| StudyErrorKind::Model { context: ctx.to_string(), source })
-    };
+/// The DOFs that loads, joints and outputs name (those of the full model), and the reduction
+/// that maps their vectors to the analysed model.
+struct DofSpace<'a> {
+    dofs: &'a [DofLabel],
+    reduction: Option<&'a Reduction>,
+}
+
+impl DofSpace<'_> {
+    fn index(&self, name: &str, ctx: &str) -> Result<usize, StudyErrorKind> {
+        self.dofs.iter().position(|d| d.name == name).ok_or_else(|| {
+            let shown: Vec<&str> = self.dofs.iter().take(12).map(|d| d.name.as_str()).collect();
+            let known = if self.dofs.len() > 12 {
+                format!("{}, ... ({} in all)", shown.join(", "), self.dofs.len())
+            } else {
+                shown.join(", ")
+            };
+            StudyErrorKind::Model {
+                context: ctx.to_string(),
+                source: ModelError::UnknownDof { name: name.into(), known },
+            }
+        })
+    }
+}
+
+/// The vector over the full model's DOFs that a placement stands for.
+fn full_vector(space: &DofSpace, p: &Placement, ctx: &str) -> Result<Vec<f64>, StudyErrorKind> {
+    let n = space.dofs.len();
     match p {
-        Placement::Dof(a) => Ok(relative_direction(n, index(a)?, None)),
-        Placement::Between(a, b) => Ok(relative_direction(n, index(a)?, Some(index(b)?))),
+        Placement::Dof(a) => Ok(relative_direction(n, space.index(a, ctx)?, None)),
+        Placement::Between(a, b) => Ok(relative_direction(n, space.index(a, ctx)?, Some(space.index(b, ctx)?))),
         Placement::Vector(v) if v.len() != n => Err(StudyErrorKind::Invalid(format!(
             "{ctx}: vector has {} values, expected {n} (one per DOF of the model)",
             v.len()
         ))),
         Placement::Vector(v) => Ok(v.clone()),
     }
+}
+
+/// The vector over the analysed model's DOFs: projected by the reduction (`Tᵀ v`) if any.
+fn vector(space: &DofSpace, p: &Placement, ctx: &str) -> Result<Vec<f64>, StudyErrorKind> {
+    let v = full_vector(space, p, ctx)?;
+    Ok(match space.reduction {
+        Some(r) => r.project(&v),
+        None => v,
+    })
+}
+
+/// The paper normalises an application vector given by the user (Section 3.4), after its
+/// projection on a reduced basis: the threshold is then a force along a unit direction.
+fn normalise_user_vector(v: &mut [f64], p: &Placement, ctx: &str) -> Result<(), StudyErrorKind> {
+    if let Placement::Vector(_) = p {
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            return Err(StudyErrorKind::Invalid(format!("{ctx}: vector is zero (on the analysed model's DOFs)")));
+        }
+        v.iter_mut().for_each(|x| *x /= norm);
+    }
+    Ok(())
+}
+
+/// All the stiffness the model has along `v` (paper Eq. 7). Eq. 7 is written for a unit
+/// vector: k_n = V_nᵀ K V_n with V_n = V/|V|. The element sees u = Vᵀ U = |V| u_n, so the same
+/// energy needs k = k_n / |V|² = VᵀKV / |V|⁴ (for `between`, |V|² = 2; for `dof` and
+/// normalised vectors, 1).
+fn replaced_stiffness(linear: &LinearModel, v: &[f64]) -> f64 {
+    let norm2: f64 = v.iter().map(|x| x * x).sum();
+    stiffness_along(linear, v) / (norm2 * norm2)
+}
+
+/// Read and assemble a mesh; `material` goes to every solid.
+fn read_mesh(path: &Path, material: Option<&MaterialSpec>) -> Result<FeModel, StudyErrorKind> {
+    let mesh_error = |source| StudyErrorKind::Mesh { context: "[model] mesh".into(), source };
+    let is_msh = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("msh"));
+    let mut mesh = if is_msh {
+        stickslip_fe::mesh::gmsh::read(path).map_err(mesh_error)?
+    } else {
+        stickslip_fe::mesh::inp::read(path).map_err(mesh_error)?
+    };
+    if let Some(m) = material {
+        let material = Material { young: m.young, poisson: m.poisson, density: m.density };
+        mesh.assign_material(None, "STUDY", material).map_err(mesh_error)?;
+    }
+    FeModel::assemble(mesh).map_err(|source| StudyErrorKind::Assembly { context: "[model] mesh".into(), source })
+}
+
+/// The reduction of `[reduction]`: retained DOFs from node sets (mesh) or DOF names.
+fn reduce(
+    full: &LinearModel,
+    fe: Option<&FeModel>,
+    spec: &ReductionSpec,
+    releases: &[Release],
+) -> Result<Reduction, StudyErrorKind> {
+    const CTX: &str = "[reduction] retain";
+    let space = DofSpace { dofs: &full.dofs, reduction: None };
+    let mut retained: Vec<usize> = Vec::new();
+    for name in &spec.retain {
+        let set = fe.and_then(|fe| fe.mesh.node_set(name).map(|_| fe.set_dofs(name)));
+        let dofs = match set {
+            Some(dofs) => dofs.map_err(|source| StudyErrorKind::Assembly { context: CTX.into(), source })?,
+            None => vec![space.index(name, &format!("{CTX} (neither a node set of the mesh nor a DOF)"))?],
+        };
+        for d in dofs {
+            if !retained.contains(&d) {
+                retained.push(d);
+            }
+        }
+    }
+    let options = ReductionOptions { retained, modes: spec.modes, eigen: EigenOptions::default() };
+    let reduction_error = |source| StudyErrorKind::Reduction { context: "[reduction]".into(), source };
+    match spec.method {
+        ReductionMethod::CraigBampton => reduction::craig_bampton(full, &options),
+        ReductionMethod::FreeModes => reduction::free_modes(full, &options),
+        ReductionMethod::Enriched { release_modes } => {
+            if releases.is_empty() {
+                return Err(StudyErrorKind::Invalid(
+                    "[reduction]: method \"enriched\" releases the joints that replace stiffness (paper form), and there are none".into(),
+                ));
+            }
+            reduction::enriched(full, &options, releases, release_modes)
+        }
+    }
+    .map_err(reduction_error)
 }
 
 /// `node.direction` names (as in CalculiX `.dof` files) become nodal labels.

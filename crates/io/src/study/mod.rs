@@ -26,6 +26,9 @@ pub struct Study {
     /// The study file; relative paths inside it resolve against its folder.
     pub path: PathBuf,
     pub model: ModelSpec,
+    /// Reduction of the model before the nonlinear analysis (paper Section 3.3); `None` keeps
+    /// the model as it is.
+    pub reduction: Option<ReductionSpec>,
     pub damping: DampingSpec,
     pub loads: Vec<LoadSpec>,
     pub joints: Vec<JointSpec>,
@@ -53,6 +56,41 @@ pub enum ModelSpec {
     /// Matrix Market files (paths already resolved against the study folder) and optional DOF
     /// names (a `dof_file` or an inline `dofs` list; otherwise the DOFs are named "1", "2", ...).
     Files { mass: PathBuf, stiffness: PathBuf, dofs: DofNames, at: ModelLocations },
+    /// A finite element mesh (Abaqus/CalculiX `.inp` or Gmsh `.msh`) assembled by
+    /// `stickslip-fe`; its DOFs are named `node.direction`. `material` is assigned to every
+    /// solid (required for `.msh`, which carries no material).
+    Mesh { path: PathBuf, material: Option<MaterialSpec>, at: ModelLocations },
+}
+
+/// Isotropic elastic material: Young's modulus (Pa), Poisson's ratio, density (kg/m³).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialSpec {
+    pub young: f64,
+    pub poisson: f64,
+    pub density: f64,
+}
+
+/// Reduction basis (paper Section 3.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReductionMethod {
+    /// Constraint modes + fixed-interface modes (Craig-Bampton, Eqs. 3-4).
+    CraigBampton,
+    /// Constraint modes + free modes cleaned on the retained DOFs (the paper's, Eq. 5).
+    FreeModes,
+    /// The free-mode basis enriched with `release_modes` modes of the structure with the
+    /// joints that replace stiffness released.
+    Enriched { release_modes: usize },
+}
+
+/// `[reduction]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReductionSpec {
+    pub method: ReductionMethod,
+    /// Retained DOFs: node sets of the mesh (all DOFs of their nodes) or DOF names.
+    pub retain: Vec<String>,
+    /// Number of modes in the basis.
+    pub modes: usize,
+    pub at: Location,
 }
 
 /// Where the `[model]` section and its mass and stiffness keys are, for errors found when the
@@ -300,6 +338,24 @@ pub enum StudyErrorKind {
         context: String,
         #[source]
         source: stickslip_core::model::ModelError,
+    },
+    #[error("{context}: {source}")]
+    Mesh {
+        context: String,
+        #[source]
+        source: stickslip_fe::mesh::MeshError,
+    },
+    #[error("{context}: {source}")]
+    Assembly {
+        context: String,
+        #[source]
+        source: stickslip_fe::assembly::AssemblyError,
+    },
+    #[error("{context}: {source}")]
+    Reduction {
+        context: String,
+        #[source]
+        source: stickslip_fe::reduction::ReductionError,
     },
     #[error("{context}: {source}")]
     Element {

@@ -12,6 +12,7 @@ pub(crate) type S<T> = Spanned<T>;
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawStudy {
     pub model: S<RawModel>,
+    pub reduction: Option<S<RawReduction>>,
     pub damping: Option<S<RawDamping>>,
     #[serde(default)]
     pub load: Vec<S<RawLoad>>,
@@ -44,6 +45,25 @@ pub(crate) struct RawModel {
     pub stiffness_file: Option<S<String>>,
     pub damping_file: Option<S<String>>,
     pub dof_file: Option<S<String>>,
+    pub mesh: Option<S<String>>,
+    pub material: Option<S<RawMaterial>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawMaterial {
+    pub young: S<f64>,
+    pub poisson: S<f64>,
+    pub density: S<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawReduction {
+    pub method: S<String>,
+    pub retain: S<Vec<String>>,
+    pub modes: S<i64>,
+    pub release_modes: Option<S<i64>>,
 }
 
 #[derive(Deserialize)]

@@ -79,9 +79,10 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     let n_inline = match &model {
         ModelSpec::Inline { dofs, .. } => Some(dofs.len()),
         ModelSpec::Files { dofs: DofNames::Inline(d), .. } => Some(d.len()),
-        ModelSpec::Files { .. } => None,
+        ModelSpec::Files { .. } | ModelSpec::Mesh { .. } => None,
     };
     let damping = damping(&src, raw.damping.as_ref(), file_damping, n_inline)?;
+    let reduction = raw.reduction.as_ref().map(|r| reduction(&src, r)).transpose()?;
 
     let mut loads = Vec::new();
     for l in &raw.load {
@@ -131,6 +132,7 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     Ok(Study {
         path: file.to_path_buf(),
         model,
+        reduction,
         damping,
         loads,
         joints,
@@ -258,11 +260,59 @@ fn model(
     let inline = r.mass.is_some() || r.stiffness.is_some();
     let files = r.mass_file.is_some() || r.stiffness_file.is_some();
     let damping_file = r.damping_file.as_ref().map(|p| resolve(p.get_ref()));
-    if inline && files {
+    if [inline, files, r.mesh.is_some()].iter().filter(|x| **x).count() > 1 {
         return Err(src.invalid(
             &m.span(),
-            format!("{CTX}: give either inline `mass` and `stiffness` or `mass_file` and `stiffness_file`, not both"),
+            format!(
+                "{CTX}: give one model: inline `mass` and `stiffness`, `mass_file` and `stiffness_file`, or a `mesh`"
+            ),
         ));
+    }
+    if let Some(mat) = &r.material {
+        if r.mesh.is_none() {
+            return Err(src.invalid(&mat.span(), format!("{CTX}: `material` goes with a `mesh`")));
+        }
+    }
+    if let Some(mesh) = &r.mesh {
+        for (key, given) in
+            [("dofs", r.dofs.is_some()), ("dof_file", r.dof_file.is_some()), ("damping_file", damping_file.is_some())]
+        {
+            if given {
+                return Err(src.invalid(
+                    &mesh.span(),
+                    format!(
+                        "{CTX}: `{key}` does not go with a `mesh` (its DOFs are named node.direction, e.g. \"12.3\")"
+                    ),
+                ));
+            }
+        }
+        let material = match &r.material {
+            Some(mat) => {
+                let ctx = format!("{CTX} material");
+                let mr = mat.get_ref();
+                let young = positive(src, &mr.young, &ctx, "young", " Pa")?;
+                let density = positive(src, &mr.density, &ctx, "density", " kg/m^3")?;
+                let poisson = finite(src, &mr.poisson, &ctx, "poisson")?;
+                if !(-1.0 < poisson && poisson < 0.5) {
+                    return Err(
+                        src.invalid(&mr.poisson.span(), format!("{ctx}: poisson must be in (-1, 0.5), got {poisson}"))
+                    );
+                }
+                Some(MaterialSpec { young, poisson, density })
+            }
+            None => None,
+        };
+        let path = resolve(mesh.get_ref());
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("inp" | "msh")) {
+            return Err(src.invalid(
+                &mesh.span(),
+                format!("{CTX}: mesh {:?} must be an Abaqus/CalculiX .inp or a Gmsh .msh file", mesh.get_ref()),
+            ));
+        }
+        let here = src.location(&mesh.span());
+        let at = ModelLocations { section: at, mass: here, stiffness: here };
+        return Ok((ModelSpec::Mesh { path, material, at }, None));
     }
     if inline {
         let (Some(dofs), Some(mass), Some(stiffness)) = (&r.dofs, &r.mass, &r.stiffness) else {
@@ -310,8 +360,42 @@ fn model(
     }
     Err(src.invalid(
         &m.span(),
-        format!("{CTX}: no model: give `dofs`, `mass` and `stiffness` inline, or `mass_file` and `stiffness_file` (Matrix Market)"),
+        format!("{CTX}: no model: give `dofs`, `mass` and `stiffness` inline, `mass_file` and `stiffness_file` (Matrix Market), or a `mesh`"),
     ))
+}
+
+fn reduction(src: &Source, r: &S<raw::RawReduction>) -> Result<ReductionSpec, StudyError> {
+    const CTX: &str = "[reduction]";
+    let raw = r.get_ref();
+    let modes = count(src, &raw.modes, CTX, "modes", 0)?;
+    let method = match raw.method.get_ref().as_str() {
+        "cb" => ReductionMethod::CraigBampton,
+        "free" => ReductionMethod::FreeModes,
+        "enriched" => ReductionMethod::Enriched {
+            release_modes: match &raw.release_modes {
+                Some(n) => count(src, n, CTX, "release_modes", 1)?,
+                None => {
+                    return Err(src.invalid(&raw.method.span(), format!("{CTX}: method \"enriched\" needs `release_modes`")))
+                }
+            },
+        },
+        other => {
+            return Err(src.invalid(
+                &raw.method.span(),
+                format!("{CTX}: unknown method {other:?}, expected \"cb\" (Craig-Bampton), \"free\" (free modes, the paper's) or \"enriched\""),
+            ))
+        }
+    };
+    if let (Some(n), false) = (&raw.release_modes, matches!(method, ReductionMethod::Enriched { .. })) {
+        return Err(src.invalid(&n.span(), format!("{CTX}: release_modes goes with method = \"enriched\"")));
+    }
+    if matches!(method, ReductionMethod::FreeModes | ReductionMethod::Enriched { .. }) && modes == 0 {
+        return Err(src.invalid(&raw.modes.span(), format!("{CTX}: the free-mode methods need modes >= 1")));
+    }
+    if raw.retain.get_ref().is_empty() {
+        return Err(src.invalid(&raw.retain.span(), format!("{CTX}: retain must name at least one node set or DOF")));
+    }
+    Ok(ReductionSpec { method, retain: raw.retain.get_ref().clone(), modes, at: src.location(&raw.retain.span()) })
 }
 
 fn dof_names(src: &Source, dofs: &S<Vec<String>>) -> Result<Vec<String>, StudyError> {
