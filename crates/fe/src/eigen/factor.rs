@@ -38,13 +38,23 @@ impl ShiftedFactor {
         shift: f64,
     ) -> Result<Self, EigenError> {
         let a = shifted(stiffness, mass, shift)?;
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| EigenError::Factorisation(format!("symbolic analysis failed: {e:?}")))?;
+        // Both orderings are analysed (cheap next to the numeric factorisation) and the one
+        // with the smaller factor kept: minimum degree wins on small or thin models, nested
+        // dissection on large 3-D meshes.
+        let analyse = |ordering: SymmetricOrdering<'_, usize>| {
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ordering, CholeskySymbolicParams::default())
+                .map_err(|e| EigenError::Factorisation(format!("symbolic analysis failed: {e:?}")))
+        };
+        let mut symbolic = analyse(SymmetricOrdering::Amd)?;
+        if a.nrows() > 2 * super::ordering::LEAF {
+            let fwd = super::ordering::nested_dissection(a.symbolic());
+            let inv = super::ordering::inverse(&fwd);
+            let perm = faer::perm::PermRef::new_checked(&fwd, &inv, a.nrows());
+            let nd = analyse(SymmetricOrdering::Custom(perm))?;
+            if nd.len_val() < symbolic.len_val() {
+                symbolic = nd;
+            }
+        }
         let mut f = ShiftedFactor {
             symbolic: Arc::new(symbolic),
             values: Vec::new(),

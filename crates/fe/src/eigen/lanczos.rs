@@ -46,6 +46,11 @@ pub fn modes_with_factor(
     if nev == 0 || nev > n {
         return Err(EigenError::TooManyModes { requested: nev, available: n });
     }
+    if opts.subspace.is_none() {
+        if let Some(solution) = block_krylov(k, m, factor, opts)? {
+            return Ok(solution);
+        }
+    }
     let sigma = factor.shift();
     let ncv = opts.subspace.unwrap_or((2 * nev + 20).max(nev + 30)).clamp(nev + 1, n.max(nev + 1));
     // A full-size space needs no Lanczos: fall back on ncv = n with one cycle.
@@ -243,6 +248,136 @@ fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Ma
             return;
         }
     }
+}
+
+/// Block shift-invert Lanczos without restart: blocks of `b` vectors, so that every solve
+/// with the factor serves `b` right-hand sides at once (a sparse triangular solve is bound by
+/// memory traffic through the factor: one block solve costs a few single ones), fully
+/// reorthogonalised in the M inner product. Ritz values of the projected operator, the
+/// residual estimate of each from the coupling with the next block. `None` when the
+/// subspace limit is reached before convergence (the caller falls back on thick restart).
+fn block_krylov(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    factor: &ShiftedFactor,
+    opts: &EigenOptions,
+) -> Result<Option<EigenSolution>, EigenError> {
+    let n = k.nrows();
+    let nev = opts.count;
+    let b = nev.div_ceil(3).clamp(1, 16).min(n);
+    let max_dim = (4 * nev).max(nev + 40).min(n);
+    let par = Par::rayon(0);
+    let mut v = Mat::<f64>::zeros(n, max_dim + b);
+    let mut mv = Mat::<f64>::zeros(n, max_dim + b);
+    let mut h = Mat::<f64>::zeros(max_dim + b, max_dim + b);
+    let mut solves = 0;
+    // Start block: OP applied to pseudo-random vectors.
+    let mut w = Mat::<f64>::from_fn(n, b, |i, j| pseudo_random(i + j * n));
+    let mut mw = Mat::<f64>::zeros(n, b);
+    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+    factor.solve_in_place(mw.as_mut());
+    solves += b;
+    let mut dim = append_block(m, &mut v, &mut mv, 0, mw, par);
+    // Columns [start, dim) form the last block.
+    let mut start = 0;
+    while dim > start {
+        // W = OP V_j = (K − σM)⁻¹ M V_j for the last block.
+        let nb = dim - start;
+        w = mv.subcols(start, nb).to_owned();
+        factor.solve_in_place(w.as_mut());
+        solves += nb;
+        let room = (max_dim + b - dim).min(nb);
+        let new_dim = if room > 0 {
+            append_block(m, &mut v, &mut mv, dim, w.subcols(0, nb).to_owned(), par).min(dim + room)
+        } else {
+            dim
+        };
+        // H[0..new_dim, block] = (M V)ᵀ W: the projection of OP on the basis.
+        let coef = mv.subcols(0, new_dim).transpose() * &w;
+        for c in 0..nb {
+            for r in 0..new_dim {
+                h[(r, start + c)] = coef[(r, c)];
+            }
+        }
+        // Rayleigh-Ritz on the first `dim` vectors.
+        let s = Mat::<f64>::from_fn(dim, dim, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
+        let evd = s
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|_| EigenError::Factorisation("the projected eigenproblem did not converge".into()))?;
+        let theta: Vec<f64> = (0..dim).map(|i| evd.S()[i]).collect();
+        let mut order: Vec<usize> = (0..dim).collect();
+        order.sort_by(|&a, &b| theta[b].abs().total_cmp(&theta[a].abs()));
+        if dim >= nev {
+            // ‖OP x − θ x‖_M = ‖H[next block, last block] y_last‖.
+            let residual = |i: usize| {
+                let mut r2 = 0.0;
+                for row in dim..new_dim {
+                    let mut acc = 0.0;
+                    for c in start..dim {
+                        acc += h[(row, c)] * evd.U()[(c, i)];
+                    }
+                    r2 += acc * acc;
+                }
+                r2.sqrt() / theta[i].abs().max(f64::MIN_POSITIVE)
+            };
+            if order[..nev].iter().all(|&i| residual(i) <= opts.tolerance) {
+                let sigma = factor.shift();
+                return finish(k, m, v.as_ref(), evd.U(), &theta, &order[..nev], sigma, factor, solves, 0, opts)
+                    .map(Some);
+            }
+        }
+        if new_dim == dim || new_dim > max_dim {
+            return Ok(None);
+        }
+        start = dim;
+        dim = new_dim;
+    }
+    Ok(None)
+}
+
+/// M-orthonormalise the block `w` against `v[:, 0..dim]` and within itself (twice: classical
+/// Gram-Schmidt and an eigen-decomposition of the block's Gram matrix, which drops directions
+/// already in the basis), store it at column `dim` of `v` (and `M v` in `mv`); returns the new
+/// number of basis vectors.
+fn append_block(
+    m: &SparseColMat<usize, f64>,
+    v: &mut Mat<f64>,
+    mv: &mut Mat<f64>,
+    dim: usize,
+    mut w: Mat<f64>,
+    par: Par,
+) -> usize {
+    let n = w.nrows();
+    let mut mw = Mat::<f64>::zeros(n, w.ncols());
+    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+    let reference = (0..w.ncols()).map(|c| dot(w.col(c).as_mat(), mw.col(c).as_mat())).fold(0.0, f64::max);
+    for _ in 0..2 {
+        if dim > 0 {
+            for _ in 0..2 {
+                let c = mv.subcols(0, dim).transpose() * &w;
+                w -= v.subcols(0, dim) * &c;
+            }
+        }
+        sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+        let g = w.transpose() * &mw;
+        let g = Mat::<f64>::from_fn(g.nrows(), g.ncols(), |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
+        let Ok(evd) = g.self_adjoint_eigen(Side::Lower) else {
+            return dim;
+        };
+        // Directions whose M-norm fell below 1e-10 of the block's are already in the basis.
+        let kept: Vec<usize> = (0..g.nrows()).filter(|&i| evd.S()[i] > 1e-20 * reference).collect();
+        if kept.is_empty() || dim + kept.len() > v.ncols() {
+            return dim;
+        }
+        let q = Mat::<f64>::from_fn(g.nrows(), kept.len(), |r, c| evd.U()[(r, kept[c])] / evd.S()[kept[c]].sqrt());
+        w = &w * &q;
+        mw = Mat::<f64>::zeros(n, w.ncols());
+    }
+    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+    let nb = w.ncols();
+    v.subcols_mut(dim, nb).copy_from(&w);
+    mv.subcols_mut(dim, nb).copy_from(&mw);
+    dim + nb
 }
 
 fn dot(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {

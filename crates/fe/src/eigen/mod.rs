@@ -7,6 +7,7 @@
 //! returned mode's residual `‖Kφ − ω²Mφ‖ / ‖Kφ‖` is computed and returned.
 mod factor;
 mod lanczos;
+mod ordering;
 
 pub use factor::ShiftedFactor;
 pub use lanczos::{modes_with_factor, solve};
