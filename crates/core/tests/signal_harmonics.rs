@@ -148,3 +148,22 @@ fn period_frames_reassemble_points_recorded_at_different_times() {
     let d = period::integrate(&[0.0, 2.0, 0.0], 10.0).unwrap();
     assert_eq!(d, vec![0.0, -0.0, 0.2]);
 }
+
+#[test]
+fn reference_noise_enters_through_the_reference_fit_only() {
+    // A noisy reference (σ_r = 1 % of its amplitude) and a clean response of unit fundamental.
+    // The zero-crossing jitter shifts each cycle's phase origin, but the rotation onto the
+    // reference's own fitted fundamental removes that shift; what remains is the noise of that
+    // fit, σ_r √(2/n) in phase (rad) per cycle of n samples, i.e. in h1 for a unit amplitude.
+    let (fs, f, sigma_r) = (10_000.0, 97.3, 0.01);
+    let mut noise = Gaussian::new(5);
+    let n = 20_000;
+    let th = |j: usize| 2.0 * PI * f * j as f64 / fs;
+    let reference: Vec<f64> = (0..n).map(|j| th(j).cos() + sigma_r * noise.sample()).collect();
+    let response: Vec<f64> = (0..n).map(|j| (th(j) + 0.3).cos()).collect();
+    let blocks = extract(&reference, &[("y", &response)], fs, &SyncOptions::per_cycle(3)).unwrap();
+    let exact = num_complex::Complex64::from_polar(1.0, 0.3);
+    let rms = (blocks.iter().map(|b| (b.harmonic(0, 1) - exact).norm_sqr()).sum::<f64>() / blocks.len() as f64).sqrt();
+    let expected = sigma_r * (2.0 * f / fs).sqrt();
+    assert!(rms < 3.0 * expected && rms > expected / 3.0, "rms error {rms:.3e}, expected {expected:.3e}");
+}
