@@ -49,3 +49,13 @@ fn noise_ripples_are_not_peaks() {
     // Noise of 1 % moves the apparent maximum within the top 1 % of the peak: ±ζ f_n √0.02·2 ≈ ±0.6 Hz.
     assert!((p[0].frequency_hz - peak_frequency(100.0, 0.02)).abs() < 0.6, "{:?}", p[0]);
 }
+
+#[test]
+fn a_maximum_at_the_band_end_is_not_a_peak() {
+    // A sweep starting on the flank of a resonance (and its start-up transient) is highest at
+    // the first sample: that is not a resonance.
+    let f: Vec<f64> = (0..400).map(|i| 101.0 + 0.25 * i as f64).collect();
+    let a: Vec<f64> = f.iter().map(|&x| two_modes(x)).collect();
+    let p = peaks(&f, &a, 0.05);
+    assert_eq!(p.len(), 0, "{p:?}");
+}

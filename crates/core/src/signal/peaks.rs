@@ -23,10 +23,10 @@ pub fn peaks(frequency_hz: &[f64], amplitude: &[f64], min_prominence: f64) -> Ve
     let a = &amplitude[..n];
     let max = a.iter().copied().fold(0.0, f64::max);
     let mut out = Vec::new();
-    for i in 0..n {
-        let left_higher = i == 0 || a[i - 1] < a[i];
-        let right_higher = i + 1 == n || a[i + 1] <= a[i];
-        if !(left_higher && right_higher) || n < 3 {
+    // Interior samples only: a maximum at an end of the band (or a start-up transient) is not a
+    // resonance peak.
+    for i in 1..n.saturating_sub(1) {
+        if !(a[i - 1] < a[i] && a[i + 1] <= a[i]) {
             continue;
         }
         let base = |range: &mut dyn Iterator<Item = usize>| {
@@ -50,11 +50,8 @@ pub fn peaks(frequency_hz: &[f64], amplitude: &[f64], min_prominence: f64) -> Ve
     out
 }
 
-/// Vertex of the parabola through samples i−1, i, i+1 (the sample itself at an end).
+/// Vertex of the parabola through samples i−1, i, i+1 (0 < i < n−1).
 fn refine(f: &[f64], a: &[f64], i: usize) -> Peak {
-    if i == 0 || i + 1 >= a.len() {
-        return Peak { frequency_hz: f[i], amplitude: a[i], index: i };
-    }
     let (x0, x1, x2) = (f[i - 1], f[i], f[i + 1]);
     let (y0, y1, y2) = (a[i - 1], a[i], a[i + 1]);
     let d01 = (y1 - y0) / (x1 - x0);
