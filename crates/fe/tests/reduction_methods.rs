@@ -110,6 +110,15 @@ fn free_mode_variant_keeps_the_free_frequencies_exactly() {
         let rel = (reduced.omega[r] / full.omega[r] - 1.0).abs();
         assert!(rel < 1e-10, "mode {r}: {} vs {} ({rel:.1e})", reduced.omega[r], full.omega[r]);
     }
+    // A given shift takes the other path (modes of K − σM, constraint modes from K_ee):
+    // the same reduced frequencies.
+    let shifted =
+        ReductionOptions { eigen: EigenOptions { shift: Some(-100.0), ..Default::default() }, ..options(&case, 20) };
+    let other = reduction::free_modes(&case.model, &shifted).unwrap().model.dense_modes().unwrap();
+    assert!(red.stages.iter().any(|s| s.0 == "factorisation of K"));
+    for r in 0..20 {
+        assert!((other.omega[r] / full.omega[r] - 1.0).abs() < 1e-10, "shifted path, mode {r}");
+    }
     // The reported basis frequencies are the full model's.
     assert!((red.basis_frequencies_hz[0] / full.frequencies_hz()[0] - 1.0).abs() < 1e-10);
     // Basis properties (Section 3.3): static modes unit on their DOF and zero on the other

@@ -2,7 +2,8 @@
 //! retained DOFs (Eq. 5), orthogonalisation, projection.
 use std::time::Instant;
 
-use faer::sparse::linalg::matmul::sparse_dense_matmul;
+use faer::prelude::Solve;
+use faer::sparse::linalg::matmul::dense_sparse_matmul;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Accum, Mat, Par, Side};
 use stickslip_core::model::{LinearModel, Matrix};
@@ -85,6 +86,30 @@ fn constraint_modes(k: &SparseColMat<usize, f64>, part: &Partition, kee: &Shifte
     psi
 }
 
+/// Constraint modes from a factorisation of the whole `K` (no factorisation of `K_ee`):
+/// `G = K⁻¹ E` for the retained-DOF selector `E` satisfies `K G = E`, so `G (G_rr)⁻¹` is unit on
+/// the retained DOFs with zero forces on the others: Eqs. 3-4 exactly (`G_rr` is the
+/// flexibility at the retained DOFs, positive definite).
+fn constraint_modes_from_full(part: &Partition, n: usize, k: &ShiftedFactor) -> Option<Mat<f64>> {
+    let nr = part.retained.len();
+    let mut g = Mat::<f64>::zeros(n, nr);
+    for (c, &i) in part.retained.iter().enumerate() {
+        g[(i, c)] = 1.0;
+    }
+    k.solve_in_place(g.as_mut());
+    let grr = Mat::<f64>::from_fn(nr, nr, |a, b| 0.5 * (g[(part.retained[a], b)] + g[(part.retained[b], a)]));
+    let llt = grr.llt(Side::Lower).ok()?;
+    // Ψ = G G_rr⁻¹, i.e. Ψᵀ = G_rr⁻¹ Gᵀ (G_rr symmetric).
+    let psi_t = llt.solve(g.transpose());
+    let mut psi = psi_t.transpose().to_owned();
+    for (c, &i) in part.retained.iter().enumerate() {
+        for cc in 0..nr {
+            psi[(i, cc)] = if c == cc { 1.0 } else { 0.0 };
+        }
+    }
+    Some(psi)
+}
+
 /// Eq. 5: `Φ* = Φ − Σ_r Φ_r Ψ_r`, zero on the retained DOFs (set exactly).
 fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
     let phi_r = Mat::<f64>::from_fn(part.retained.len(), phi.ncols(), |r, c| phi[(part.retained[r], c)]);
@@ -97,22 +122,19 @@ fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
     out
 }
 
-/// `A X` for a model matrix.
-fn apply(a: &Matrix, x: &Mat<f64>) -> Mat<f64> {
-    match a {
-        Matrix::Dense(d) => d * x,
-        Matrix::Sparse(s) => {
-            let mut out = Mat::<f64>::zeros(s.nrows(), x.ncols());
-            sparse_dense_matmul(out.as_mut(), Accum::Replace, s.as_ref(), x.as_ref(), 1.0, Par::rayon(0));
-            out
-        }
-    }
-}
-
-/// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry).
+/// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry). For a sparse A
+/// the product is formed as `(Tᵀ A) T` with `Tᵀ` stored by columns, so that each stored entry
+/// of A updates one contiguous column of `m` values.
 pub(super) fn project_matrix(a: &Matrix, t: &Mat<f64>) -> Mat<f64> {
-    let at = apply(a, t);
-    let p = t.transpose() * &at;
+    let p = match a {
+        Matrix::Dense(d) => t.transpose() * (d * t),
+        Matrix::Sparse(s) => {
+            let tt = t.transpose().to_owned();
+            let mut ta = Mat::<f64>::zeros(t.ncols(), s.ncols());
+            dense_sparse_matmul(ta.as_mut(), Accum::Replace, tt.as_ref(), s.as_ref(), 1.0, Par::rayon(0));
+            &ta * t
+        }
+    };
     Mat::from_fn(p.nrows(), p.ncols(), |i, j| 0.5 * (p[(i, j)] + p[(j, i)]))
 }
 
@@ -129,8 +151,7 @@ fn orthonormalise(model: &LinearModel, x: Mat<f64>) -> Mat<f64> {
     if x.ncols() == 0 {
         return x;
     }
-    let mx = apply(&model.mass, &x);
-    let mut gm = x.transpose() * &mx;
+    let mut gm = project_matrix(&model.mass, &x);
     // Unit M-norm columns first, so that the dependence test is scale-free.
     let scale: Vec<f64> = (0..x.ncols()).map(|c| 1.0 / gm[(c, c)].max(f64::MIN_POSITIVE).sqrt()).collect();
     for i in 0..gm.nrows() {
@@ -219,16 +240,51 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
 /// eigenfrequencies as the full one.
 pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
-    let (part, psi, mut stages) = static_part(model, &k, &opts.retained)?;
-    let start = Instant::now();
-    let sol = eigen::solve(&k, &m, &eigen_options(opts, opts.modes.max(1)))?;
-    stages.push(("free modes", start.elapsed().as_secs_f64()));
+    let (part, psi, sol, mut stages) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
     let dynamic = orthonormalise(model, clean(&phi, &psi, &part));
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
     let freqs = frequencies(&sol);
     finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
+}
+
+type StaticAndFree = (Partition, Mat<f64>, EigenSolution, Vec<(&'static str, f64)>);
+
+/// Constraint modes and the free modes. When no shift is asked and K is positive definite, a
+/// single LDLᵀ of K serves both (shift 0 is then below the spectrum); otherwise (a free-free
+/// structure, a given shift) the modes use `K − σM` and the constraint modes `K_ee`.
+fn static_and_free_modes(
+    model: &LinearModel,
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    opts: &ReductionOptions,
+) -> Result<StaticAndFree, ReductionError> {
+    let part = partition(model, &opts.retained)?;
+    let eig = eigen_options(opts, opts.modes.max(1));
+    if opts.eigen.shift.is_none() {
+        let start = Instant::now();
+        if let Ok(factor) = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), 0.0) {
+            let t_factor = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            let sol = eigen::modes_with_factor(k, m, &factor, &eig)?;
+            let t_modes = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            if let Some(psi) = constraint_modes_from_full(&part, model.n_dofs(), &factor) {
+                let stages = vec![
+                    ("factorisation of K", t_factor),
+                    ("free modes", t_modes),
+                    ("constraint modes", start.elapsed().as_secs_f64()),
+                ];
+                return Ok((part, psi, sol, stages));
+            }
+        }
+    }
+    let (part, psi, mut stages) = static_part(model, k, &opts.retained)?;
+    let start = Instant::now();
+    let sol = eigen::solve(k, m, &eig)?;
+    stages.push(("free modes", start.elapsed().as_secs_f64()));
+    Ok((part, psi, sol, stages))
 }
 
 fn static_part(
@@ -256,10 +312,7 @@ pub fn enriched(
 ) -> Result<Reduction, ReductionError> {
     let n = model.n_dofs();
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
-    let (part, psi, mut stages) = static_part(model, &k, &opts.retained)?;
-    let start = Instant::now();
-    let sol = eigen::solve(&k, &m, &eigen_options(opts, opts.modes.max(1)))?;
-    stages.push(("free modes", start.elapsed().as_secs_f64()));
+    let (part, psi, sol, mut stages) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let k_released = released_stiffness(&k, releases, n)?;
     let rel = eigen::solve(&k_released, &m, &eigen_options(opts, release_modes.max(1)))?;
