@@ -207,3 +207,19 @@ fn element_face_surfaces_collect_corner_and_mid_edge_nodes() {
     // edges (0,1), (4,5), (0,4), (1,5).
     assert_eq!(hex, vec![0, 4, 5, 1, 8, 12, 16, 17]);
 }
+
+#[test]
+fn conflicting_constraints_are_reported_by_node_and_dof() {
+    // Node 3's u_x is the dependent DOF of two equations.
+    let deck = format!("{DECK}*EQUATION\n2\n3, 1, 1., 2, 1, -1.\n2\n3, 1, 1., 1, 1, -1.\n");
+    let err = FeModel::assemble(inp::parse(&deck, "twice.inp").unwrap()).unwrap_err().to_string();
+    assert!(err.contains("DOF 1 of node 3 is constrained twice") && err.contains("twice.inp:"), "{err}");
+    // u_3x = u_2x and u_2x = u_3x: a cycle.
+    let deck = format!("{DECK}*EQUATION\n2\n3, 1, 1., 2, 1, -1.\n2\n2, 1, 1., 3, 1, -1.\n");
+    let err = FeModel::assemble(inp::parse(&deck, "cycle.inp").unwrap()).unwrap_err().to_string();
+    assert!(err.contains("through a cycle"), "{err}");
+    // A fixed slave.
+    let deck = format!("{DECK}*EQUATION\n2\n2, 2, 1., 3, 2, -1.\n");
+    let err = FeModel::assemble(inp::parse(&deck, "fixed.inp").unwrap()).unwrap_err().to_string();
+    assert!(err.contains("DOF 2 of node 2") && err.contains("*BOUNDARY"), "{err}");
+}

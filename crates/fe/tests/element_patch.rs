@@ -29,8 +29,8 @@ fn distorted(kind: SolidKind) -> (Mesh, Vec<bool>) {
     let mut rng = Lcg(7);
     for (n, node) in mesh.nodes.iter_mut().enumerate() {
         if !boundary[n] {
-            for d in 0..3 {
-                node.xyz[d] += 0.08 * SIZE[d] / 3.0 * rng.next();
+            for (x, size) in node.xyz.iter_mut().zip(SIZE) {
+                *x += 0.08 * size / 3.0 * rng.next();
             }
         }
     }
