@@ -193,3 +193,13 @@ fn write_results_writes_table_arrays_time_data_and_plots() {
         std::fs::remove_dir_all(dir.parent().unwrap()).unwrap();
     }
 }
+
+#[test]
+fn time_series_of_different_lengths_are_refused() {
+    let dir = scratch_dir("time-len");
+    let mut p = point(200.0, 3, 16);
+    p.elements[0].slider_velocity.pop();
+    let msg = stickslip_io::output::write_point_csv(&dir.join("p.csv"), &p).unwrap_err().to_string();
+    assert!(msg.ends_with("p.csv: series joint_1_slider_vel_m_s has 15 samples, others 16"), "{msg}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -98,14 +98,13 @@ pub fn write_frf_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
     text.push('\n');
     for l in levels {
         for p in &l.points {
-            let row = frf_row(l.level_n, p);
-            write!(text, "{:e},{:e},{},{:e},", row[0], row[1], p.iterations, row[3]).expect("String write");
-            if row.len() > 4 {
-                push_row(&mut text, &row[4..]);
-            } else {
-                text.pop();
-                text.push('\n');
+            // The iteration count as an integer, every other number in round-trip form.
+            write!(text, "{:e},{:e},{},{:e}", l.level_n, p.frequency_hz, p.iterations, p.residual)
+                .expect("String write");
+            for v in &frf_row(l.level_n, p)[4..] {
+                write!(text, ",{v:e}").expect("String write");
             }
+            text.push('\n');
         }
     }
     write_file(path, &text)
@@ -115,52 +114,37 @@ pub fn write_frf_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
 /// `<out>_vel_m_s`, per element `<el>_u_m`, `<el>_force_N`, `<el>_slider_vel_m_s`; one row
 /// per sample `θ_j = 2π j / n_t`. Series that were not kept are left out.
 pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> {
-    let n_t =
-        p.outputs.iter().map(|o| o.disp.len()).chain(p.elements.iter().map(|e| e.loop_u.len())).max().unwrap_or(0);
-    let mut names = vec!["theta_rad".to_string(), "time_s".to_string()];
-    let mut series: Vec<&[f64]> = Vec::new();
-    let mut add = |name: String, s: &'static str, v: &[f64]| -> Result<(), OutputError> {
-        if v.is_empty() {
-            return Ok(());
-        }
-        if v.len() != n_t {
-            return Err(OutputError::Inconsistent {
-                level_n: f64::NAN,
-                frequency_hz: p.frequency_hz,
-                message: format!("time series {name}{s} has {} samples, expected {n_t}", v.len()),
-            });
-        }
-        names.push(format!("{name}{s}"));
-        Ok(())
-    };
+    let mut columns: Vec<(String, &[f64])> = Vec::new();
     for o in &p.outputs {
-        add(o.name.clone(), "_disp_m", &o.disp)?;
-        add(o.name.clone(), "_vel_m_s", &o.vel)?;
+        columns.push((format!("{}_disp_m", o.name), &o.disp));
+        columns.push((format!("{}_vel_m_s", o.name), &o.vel));
     }
     for e in &p.elements {
-        add(e.name.clone(), "_u_m", &e.loop_u)?;
-        add(e.name.clone(), "_force_N", &e.loop_force)?;
-        add(e.name.clone(), "_slider_vel_m_s", &e.slider_velocity)?;
+        columns.push((format!("{}_u_m", e.name), &e.loop_u));
+        columns.push((format!("{}_force_N", e.name), &e.loop_force));
+        columns.push((format!("{}_slider_vel_m_s", e.name), &e.slider_velocity));
     }
-    for o in &p.outputs {
-        series.extend([o.disp.as_slice(), o.vel.as_slice()].into_iter().filter(|s| !s.is_empty()));
+    columns.retain(|(_, v)| !v.is_empty());
+    let n_t = columns.iter().map(|(_, v)| v.len()).max().unwrap_or(0);
+    if let Some((name, v)) = columns.iter().find(|(_, v)| v.len() != n_t) {
+        return Err(OutputError::TimeData {
+            path: path.to_path_buf(),
+            message: format!("series {name} has {} samples, others {n_t}", v.len()),
+        });
     }
-    for e in &p.elements {
-        series.extend(
-            [e.loop_u.as_slice(), e.loop_force.as_slice(), e.slider_velocity.as_slice()]
-                .into_iter()
-                .filter(|s| !s.is_empty()),
-        );
+    let mut text = String::from("theta_rad,time_s");
+    for (name, _) in &columns {
+        text.push(',');
+        text.push_str(name);
     }
-    let mut text = names.join(",");
     text.push('\n');
     let omega = 2.0 * std::f64::consts::PI * p.frequency_hz;
-    let mut row = Vec::with_capacity(series.len() + 2);
+    let mut row = Vec::with_capacity(columns.len() + 2);
     for j in 0..n_t {
         let theta = 2.0 * std::f64::consts::PI * j as f64 / n_t as f64;
         row.clear();
         row.extend([theta, theta / omega]);
-        row.extend(series.iter().map(|s| s[j]));
+        row.extend(columns.iter().map(|(_, v)| v[j]));
         push_row(&mut text, &row);
     }
     write_file(path, &text)

@@ -121,6 +121,9 @@ pub enum OutputError {
     /// Points of one file must share outputs, elements and the number of harmonics.
     #[error("level {level_n} N, point at {frequency_hz} Hz: {message}")]
     Inconsistent { level_n: f64, frequency_hz: f64, message: String },
+    /// The time series of one point must have the same number of samples.
+    #[error("{}: {message}", path.display())]
+    TimeData { path: PathBuf, message: String },
     #[error("{0}")]
     Plot(String),
 }
