@@ -184,6 +184,16 @@ fn kinematic_coupling_keywords_build_the_same_model() {
     }
     // Node 2 keeps u_x; node 1 is fixed; nodes 3, 4 follow the reference node's 6 DOFs.
     assert_eq!(models[0].model.n_dofs(), 7);
+    // Coupling u_x alone: the slaves keep u_y, u_z, and the reference node keeps only the DOFs
+    // u_x follows (u_x, θ_y, θ_z), so no massless DOF is left in the model.
+    let fe = FeModel::assemble(
+        inp::parse(&format!("{base}*KINEMATIC COUPLING, REF NODE=100\nTOP, 1, 1\n"), "x.inp").unwrap(),
+    )
+    .unwrap();
+    let names: Vec<&str> = fe.model.dofs.iter().map(|d| d.name.as_str()).collect();
+    assert_eq!(names, ["2.1", "3.2", "3.3", "4.2", "4.3", "100.1", "100.5", "100.6"]);
+    let m = fe.model.mass.to_dense();
+    assert!((0..names.len()).all(|i| m[(i, i)] > 0.0), "every DOF has mass");
 }
 
 #[test]

@@ -104,11 +104,6 @@ impl DofMap {
                 status[full(n, d)] = Status::Free;
             }
         }
-        for c in &mesh.couplings {
-            for d in 1..=6 {
-                status[full(c.reference, d)] = Status::Free;
-            }
-        }
         for e in &mesh.equations {
             for &(n, d, _) in &e.terms {
                 status[full(n, d)] = Status::Free;
@@ -139,6 +134,13 @@ impl DofMap {
                         };
                         terms.push((full(r, 4 + j as u8), a[k]));
                         terms.push((full(r, 4 + k as u8), -a[j]));
+                    }
+                    // The reference DOFs a slave follows are active (only those: a coupling
+                    // of DOF 1 alone leaves the reference's u_y, u_z, θ_x massless and out).
+                    for &(q, c) in &terms {
+                        if c != 0.0 && matches!(status[q], Status::Inactive) {
+                            status[q] = Status::Free;
+                        }
                     }
                     let p = full(s, d);
                     if let Status::Dependent(_, by) = &status[p] {
