@@ -96,6 +96,9 @@ impl Element for Iwan {
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], mut tangent: Option<&mut Tangent>) {
         let s = self.stiffnesses.len();
         let mut total = 0.0;
+        if let Some(t) = tangent.as_deref_mut() {
+            t.dg_du[0] = 0.0;
+        }
         for i in 0..s {
             let (k, fc) = (self.stiffnesses[i], self.thresholds[i]);
             let trial = k * (u[0] - state[i]);
@@ -109,13 +112,11 @@ impl Element for Iwan {
             };
             total += f;
             if let Some(t) = tangent.as_deref_mut() {
-                if stuck {
-                    t.dg_du[0] += k;
-                    t.dg_ds[i] = -k;
-                    t.ds_ds[i * s + i] = 1.0;
-                } else {
-                    t.ds_du[i] = 1.0;
-                }
+                let (stick, slip) = if stuck { (1.0, 0.0) } else { (0.0, 1.0) };
+                t.dg_du[0] += stick * k;
+                t.dg_ds[i] = -stick * k;
+                t.ds_ds[i * s + i] = stick;
+                t.ds_du[i] = slip;
             }
         }
         let linear = if self.replaces_stiffness { self.stiffness() } else { 0.0 };

@@ -92,14 +92,12 @@ impl Element for Jenkins {
         let linear = if self.replaces_stiffness { k } else { 0.0 };
         g[0] = f - linear * u[0];
         if let Some(t) = tangent {
-            if stuck {
-                t.dg_du[0] = k - linear;
-                t.dg_ds[0] = -k;
-                t.ds_ds[0] = 1.0;
-            } else {
-                t.dg_du[0] = -linear;
-                t.ds_du[0] = 1.0;
-            }
+            // Stick: f = k (u − w), w kept. Slip: f = ±F_c, w = u ∓ F_c/k.
+            let (stick, slip) = if stuck { (1.0, 0.0) } else { (0.0, 1.0) };
+            t.dg_du[0] = stick * k - linear;
+            t.dg_ds[0] = -stick * k;
+            t.ds_ds[0] = stick;
+            t.ds_du[0] = slip;
         }
     }
 }

@@ -57,7 +57,7 @@ impl Tangent {
         }
     }
 
-    /// Set every entry to zero (laws only write their non-zero entries).
+    /// Set every entry to zero.
     pub fn clear(&mut self) {
         for v in [&mut self.dg_du, &mut self.dg_dv, &mut self.dg_ds, &mut self.ds_du, &mut self.ds_dv, &mut self.ds_ds]
         {
@@ -110,7 +110,9 @@ pub trait Element: Send + Sync + std::fmt::Debug {
 
     /// One step of the law: from the state before (updated in place to the state after), the
     /// displacement `u` and velocity `v` now, write the restoring force `g` and, if asked, the
-    /// partial derivatives (the tangent is cleared by the caller).
+    /// partial derivatives. The tangent starts zeroed and is reused from call to call without
+    /// clearing (this runs for every time sample): a law writes, at every call, every entry it
+    /// ever makes non-zero.
     fn update(&self, u: &[f64], v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>);
 
     /// Stiffness of the linear model that the element replaces (paper form, Eq. 11: `k_J`), so

@@ -68,10 +68,11 @@ pub struct ElementAft {
     state_before: Vec<f64>,
     state_period_start: Vec<f64>,
     tangent: Tangent,
-    /// `S` (`s × (nc·d + 1)`) before and after an update.
-    sens: Mat<f64>,
-    sens_next: Mat<f64>,
-    /// `∂g_j/∂(X, Ω)` rows for each direction: `dgdx[a]` is `nt × (nc·d + 1)`.
+    /// `S` before and after an update, row-major `s × (nc·d + 1)`.
+    sens: Vec<f64>,
+    sens_next: Vec<f64>,
+    /// `∂g_j/∂(X, Ω)` for each direction, one contiguous column per sample:
+    /// `dgdx[a]` is `(nc·d + 1) × nt`.
     dgdx: Vec<Mat<f64>>,
     /// `P ∂g/∂X` for one direction, `nc × (nc·d + 1)`.
     projected: Mat<f64>,
@@ -103,9 +104,9 @@ impl ElementAft {
             state_before: vec![0.0; s],
             state_period_start: vec![0.0; s],
             tangent: Tangent::new(d, s),
-            sens: Mat::zeros(s, cols),
-            sens_next: Mat::zeros(s, cols),
-            dgdx: (0..d).map(|_| Mat::zeros(nt, cols)).collect(),
+            sens: vec![0.0; s * cols],
+            sens_next: vec![0.0; s * cols],
+            dgdx: (0..d).map(|_| Mat::zeros(cols, nt)).collect(),
             projected: Mat::zeros(nc, cols),
             coeff_buf: vec![0.0; nc],
             time_buf: vec![0.0; nt],
@@ -142,21 +143,21 @@ impl ElementAft {
             }
         }
         let want_jac = jacobian.is_some();
-        let e = plan.synthesis();
-        let de = plan.synthesis_derivative_matrix();
+        let e0 = plan.basis_at(0);
         let velocity = law.depends_on_velocity();
+        let cols = nc * d + 1;
 
         // Initial state and its sensitivity to X through u(θ_0) = E_0 X.
         self.load_sample(0);
         law.initial_state(&self.u_now, &mut self.state, want_jac.then_some(&mut self.ds0[..]));
         if want_jac {
-            self.sens.fill(0.0);
+            self.sens.iter_mut().for_each(|v| *v = 0.0);
             for m in 0..s {
                 for a in 0..d {
                     let w = self.ds0[m * d + a];
                     if w != 0.0 {
                         for c in 0..nc {
-                            self.sens[(m, c * d + a)] += w * e[(0, c)];
+                            self.sens[m * cols + c * d + a] += w * e0[c];
                         }
                     }
                 }
@@ -172,9 +173,6 @@ impl ElementAft {
             for j in 0..nt {
                 self.load_sample(j);
                 self.state_before.copy_from_slice(&self.state);
-                if want_jac {
-                    self.tangent.clear();
-                }
                 law.update(
                     &self.u_now,
                     &self.v_now,
@@ -187,7 +185,7 @@ impl ElementAft {
                 }
                 self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
                 if want_jac {
-                    self.differentiate_sample(j, omega, velocity, e, de);
+                    self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
                 }
             }
             if !hysteretic {
@@ -218,7 +216,7 @@ impl ElementAft {
         if let Some((mut jac, dg_domega)) = jacobian {
             let p = plan.projection();
             for a in 0..d {
-                matmul(self.projected.as_mut(), Accum::Replace, p.as_ref(), self.dgdx[a].as_ref(), 1.0, Par::Seq);
+                matmul(self.projected.as_mut(), Accum::Replace, p.as_ref(), self.dgdx[a].transpose(), 1.0, Par::Seq);
                 for c in 0..nc {
                     let row = c * d + a;
                     for col in 0..nc * d {
@@ -239,33 +237,30 @@ impl ElementAft {
         }
     }
 
-    /// Chain rule through one update (module docs): rows `∂g_j/∂(X, Ω)` and the next `S`.
-    fn differentiate_sample(&mut self, j: usize, omega: f64, velocity: bool, e: &Mat<f64>, de: &Mat<f64>) {
+    /// Chain rule through one update (module docs): `∂g_j/∂(X, Ω)` and the next `S`, with `e`
+    /// and `de` the basis and its θ-derivative at sample j. Contiguous slices only: this runs
+    /// for every sample of every period of every element at every Newton iteration.
+    fn differentiate_sample(&mut self, j: usize, omega: f64, velocity: bool, e: &[f64], de: &[f64]) {
         let (d, s, nc, nt) = (self.d, self.s, self.nc, self.nt);
         let cols = nc * d + 1;
         let t = &self.tangent;
-        // ∂g_a/∂(X, Ω).
         for a in 0..d {
-            let row = &mut self.dgdx[a];
-            for col in 0..cols {
-                row[(j, col)] = 0.0;
-            }
+            let row = self.dgdx[a].col_as_slice_mut(j);
+            row.iter_mut().for_each(|v| *v = 0.0);
             for b in 0..d {
                 let gu = t.dg_du[a * d + b];
                 let gv = if velocity { t.dg_dv[a * d + b] } else { 0.0 };
                 if gu != 0.0 || gv != 0.0 {
-                    for c in 0..nc {
-                        row[(j, c * d + b)] += gu * e[(j, c)] + gv * omega * de[(j, c)];
-                    }
+                    accumulate_basis(&mut row[..nc * d], d, b, gu, gv * omega, e, de);
                     // v = Ω du/dθ: ∂v/∂Ω = du/dθ.
-                    row[(j, nc * d)] += gv * self.dudtheta[b * nt + j];
+                    row[nc * d] += gv * self.dudtheta[b * nt + j];
                 }
             }
             for m in 0..s {
                 let gs = t.dg_ds[a * s + m];
                 if gs != 0.0 {
-                    for col in 0..cols {
-                        row[(j, col)] += gs * self.sens[(m, col)];
+                    for (r, sv) in row.iter_mut().zip(&self.sens[m * cols..(m + 1) * cols]) {
+                        *r += gs * sv;
                     }
                 }
             }
@@ -275,29 +270,48 @@ impl ElementAft {
         }
         // S_j from S_{j−1}.
         for m in 0..s {
-            for col in 0..cols {
-                self.sens_next[(m, col)] = 0.0;
-            }
+            let next = &mut self.sens_next[m * cols..(m + 1) * cols];
+            next.iter_mut().for_each(|v| *v = 0.0);
             for b in 0..d {
                 let su = t.ds_du[m * d + b];
                 let sv = if velocity { t.ds_dv[m * d + b] } else { 0.0 };
                 if su != 0.0 || sv != 0.0 {
-                    for c in 0..nc {
-                        self.sens_next[(m, c * d + b)] += su * e[(j, c)] + sv * omega * de[(j, c)];
-                    }
-                    self.sens_next[(m, nc * d)] += sv * self.dudtheta[b * nt + j];
+                    accumulate_basis(&mut next[..nc * d], d, b, su, sv * omega, e, de);
+                    next[nc * d] += sv * self.dudtheta[b * nt + j];
                 }
             }
             for l in 0..s {
                 let ss = t.ds_ds[m * s + l];
                 if ss != 0.0 {
-                    for col in 0..cols {
-                        self.sens_next[(m, col)] += ss * self.sens[(l, col)];
+                    for (x, y) in next.iter_mut().zip(&self.sens[l * cols..(l + 1) * cols]) {
+                        *x += ss * y;
                     }
                 }
             }
         }
         std::mem::swap(&mut self.sens, &mut self.sens_next);
+    }
+}
+
+/// `target[c·d + b] += α e_c + β de_c` for every coefficient c: the contribution of one
+/// direction's `∂/∂u` and `∂/∂v` at a sample. Contiguous fast paths for the usual one-direction,
+/// velocity-independent laws.
+#[inline]
+fn accumulate_basis(target: &mut [f64], d: usize, b: usize, alpha: f64, beta: f64, e: &[f64], de: &[f64]) {
+    if d == 1 {
+        if beta == 0.0 {
+            for (t, ec) in target.iter_mut().zip(e) {
+                *t += alpha * ec;
+            }
+        } else {
+            for ((t, ec), dec) in target.iter_mut().zip(e).zip(de) {
+                *t += alpha * ec + beta * dec;
+            }
+        }
+    } else {
+        for (c, (ec, dec)) in e.iter().zip(de).enumerate() {
+            target[c * d + b] += alpha * ec + beta * dec;
+        }
     }
 }
 

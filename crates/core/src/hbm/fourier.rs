@@ -59,6 +59,10 @@ pub struct AftPlan {
     synthesis: Mat<f64>,
     /// `E'[(j, c)]`: θ-derivative of basis function c at sample j, dx/dθ = E' X.
     synthesis_derivative: Mat<f64>,
+    /// `Eᵀ` and `E'ᵀ` (`(2N+1) × n_t`): the basis at sample j as one contiguous column, for
+    /// sample-by-sample loops.
+    basis_at_sample: Mat<f64>,
+    basis_derivative_at_sample: Mat<f64>,
     /// `P[(c, j)]`: weight of sample j in coefficient c (`(2N+1) × n_t`), X = P x (exact for
     /// band-limited signals, the DFT projection otherwise). `P E = I`.
     projection: Mat<f64>,
@@ -99,7 +103,19 @@ impl AftPlan {
             let w = if c == 0 { 1.0 } else { 2.0 };
             w / n_samples as f64 * basis(c, j as f64 * dtheta)
         });
-        Ok(AftPlan { n_harmonics, n_samples, forward, inverse, synthesis, synthesis_derivative, projection })
+        let basis_at_sample = synthesis.transpose().to_owned();
+        let basis_derivative_at_sample = synthesis_derivative.transpose().to_owned();
+        Ok(AftPlan {
+            n_harmonics,
+            n_samples,
+            forward,
+            inverse,
+            synthesis,
+            synthesis_derivative,
+            basis_at_sample,
+            basis_derivative_at_sample,
+            projection,
+        })
     }
 
     pub fn n_harmonics(&self) -> usize {
@@ -123,6 +139,16 @@ impl AftPlan {
     /// Derivative synthesis matrix `E'` (`n_t × (2N+1)`): `dx/dθ(θ_j) = Σ_c E'[(j,c)] X_c`.
     pub fn synthesis_derivative_matrix(&self) -> &Mat<f64> {
         &self.synthesis_derivative
+    }
+
+    /// The basis functions at sample `j`: row j of `E`, contiguous.
+    pub fn basis_at(&self, j: usize) -> &[f64] {
+        self.basis_at_sample.col_as_slice(j)
+    }
+
+    /// Their θ-derivatives at sample `j`: row j of `E'`, contiguous.
+    pub fn basis_derivative_at(&self, j: usize) -> &[f64] {
+        self.basis_derivative_at_sample.col_as_slice(j)
     }
 
     /// Projection matrix `P` (`(2N+1) × n_t`): `X_c = Σ_j P[(c,j)] x_j`.
@@ -162,7 +188,7 @@ impl AftPlan {
             // d/dθ multiplies harmonic k by ik.
             spec[k] = if derivative == 0 { z } else { z * Complex::new(0.0, k as f64) };
         }
-        if self.n_samples % 2 == 0 {
+        if self.n_samples.is_multiple_of(2) {
             // The Nyquist bin must be real for the c2r transform; it is zero here since N < n_t/2.
             let last = spec.len() - 1;
             spec[last].im = 0.0;

@@ -21,8 +21,9 @@
 //!
 //! Physical DOFs are recovered afterwards (Eq. 27) from the same representation.
 
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
-use faer::{c64, Mat};
+use faer::{c64, Accum, Mat, Par};
 
 use crate::model::{Damping, LinearModel, ModelError, Modes};
 
@@ -42,8 +43,10 @@ pub struct ModalReceptance {
     a: Mat<f64>,
     /// `b = Φᵀ F` (m).
     b: Vec<f64>,
-    /// `outer[(i q + j, r)] = A_ir A_jr`.
-    outer: Mat<f64>,
+    /// `table[(i q + j, r)] = A_ir A_jr` for the receptance and `table[(q² + i, r)] = A_ir b_r`
+    /// for the excitation response: every harmonic is then one product of this table with the
+    /// modal weights `1/den_r` and their derivatives.
+    table: Mat<f64>,
     modes: Modes,
 }
 
@@ -64,15 +67,22 @@ pub struct HarmonicReceptance {
     /// `u_F` (q).
     pub u_force: Vec<c64>,
     pub du_force: Vec<c64>,
+    /// Modal weights (m × 4: Re, Im of 1/den and of its derivative) and their product with the
+    /// modal table ((q² + q) × 4), reused from call to call.
+    weights: Mat<f64>,
+    product: Mat<f64>,
 }
 
 impl HarmonicReceptance {
+    /// Buffers for `q` directions (sized for the modal table at the first evaluation).
     pub fn new(q: usize) -> Self {
         HarmonicReceptance {
             h: Mat::zeros(q, q),
             dh: Mat::zeros(q, q),
             u_force: vec![c64::new(0.0, 0.0); q],
             du_force: vec![c64::new(0.0, 0.0); q],
+            weights: Mat::zeros(0, 4),
+            product: Mat::zeros(0, 4),
         }
     }
 }
@@ -88,11 +98,17 @@ impl Receptance {
             let m = modes.omega.len();
             let phi = &modes.shapes;
             let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
-            let b = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
-            let outer = Mat::from_fn(q * q, m, |ij, r| a[(ij / q, r)] * a[(ij % q, r)]);
+            let b: Vec<f64> = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
+            let table = Mat::from_fn(q * q + q, m, |row, r| {
+                if row < q * q {
+                    a[(row / q, r)] * a[(row % q, r)]
+                } else {
+                    a[(row - q * q, r)] * b[r]
+                }
+            });
             let c_r =
                 modes.omega.iter().enumerate().map(|(r, &w)| model.damping.modal_coefficient(r, w).unwrap()).collect();
-            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, outer, modes }))
+            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, table, modes }))
         } else {
             // Check M > 0 and K > 0 the same way as the modal path, so both fail alike.
             model.dense_modes()?;
@@ -139,29 +155,31 @@ impl ModalReceptance {
     fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
         let q = self.a.nrows();
         let m = self.omega_r.len();
-        for i in 0..q {
-            out.u_force[i] = c64::new(0.0, 0.0);
-            out.du_force[i] = c64::new(0.0, 0.0);
-            for j in 0..q {
-                out.h[(i, j)] = c64::new(0.0, 0.0);
-                out.dh[(i, j)] = c64::new(0.0, 0.0);
-            }
+        if out.weights.nrows() != m {
+            out.weights = Mat::zeros(m, 4);
+            out.product = Mat::zeros(q * q + q, 4);
         }
         for r in 0..m {
             let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
             let inv = den.inv();
             // d(1/den)/dω = −(−2ω + i c_r)/den² = (2ω − i c_r)/den².
             let dinv = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
-            for i in 0..q {
-                let ab = self.a[(i, r)] * self.b[r];
-                out.u_force[i] += inv * ab;
-                out.du_force[i] += dinv * ab;
-                for j in 0..q {
-                    let o = self.outer[(i * q + j, r)];
-                    out.h[(i, j)] += inv * o;
-                    out.dh[(i, j)] += dinv * o;
-                }
+            out.weights[(r, 0)] = inv.re;
+            out.weights[(r, 1)] = inv.im;
+            out.weights[(r, 2)] = dinv.re;
+            out.weights[(r, 3)] = dinv.im;
+        }
+        matmul(out.product.as_mut(), Accum::Replace, self.table.as_ref(), out.weights.as_ref(), 1.0, Par::Seq);
+        let p = &out.product;
+        for i in 0..q {
+            for j in 0..q {
+                let row = i * q + j;
+                out.h[(i, j)] = c64::new(p[(row, 0)], p[(row, 1)]);
+                out.dh[(i, j)] = c64::new(p[(row, 2)], p[(row, 3)]);
             }
+            let row = q * q + i;
+            out.u_force[i] = c64::new(p[(row, 0)], p[(row, 1)]);
+            out.du_force[i] = c64::new(p[(row, 2)], p[(row, 3)]);
         }
     }
 
