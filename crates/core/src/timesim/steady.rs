@@ -154,20 +154,25 @@ pub(crate) fn run_until_periodic(
     let p = steps_per_period;
     let omega = 2.0 * std::f64::consts::PI * frequency_hz;
     let step = integrator.step_size();
-    let (alpha, _, _) = scheme_alpha(integrator);
+    let (alpha, _, _) = integrator.parameters();
     let mut records = Records::new(model, record_dofs)?;
     let mut slider = vec![0.0; integrator.n_directions()];
+    // Displacements one period back, overwritten as the period advances: a single n × P buffer.
     let mut previous = vec![0.0; n * p];
-    let mut current = vec![0.0; n * p];
     let mut below = 0;
     let mut criterion = f64::INFINITY;
     for period in 1..=max_periods {
         records.clear();
         let tally = state.energy.clone();
         let t0 = state.time;
+        let (mut diff, mut amp) = (0.0f64, 0.0f64);
         for j in 0..p {
             records.push(model, &state, &mut slider);
-            current[j * n..(j + 1) * n].copy_from_slice(&state.displacement);
+            for (pr, &u) in previous[j * n..(j + 1) * n].iter_mut().zip(&state.displacement) {
+                diff = diff.max((u - *pr).abs());
+                amp = amp.max(u.abs());
+                *pr = u;
+            }
             // Phases from the step index, not the accumulated time, so that round-off does
             // not shift the excitation over thousands of periods.
             let t_end = (j + 1) as f64 * step;
@@ -176,11 +181,6 @@ pub(crate) fn run_until_periodic(
         }
         state.time = t0 + p as f64 * step;
         if period > 1 {
-            let (mut diff, mut amp) = (0.0f64, 0.0f64);
-            for (c, pr) in current.iter().zip(&previous) {
-                diff = diff.max((c - pr).abs());
-                amp = amp.max(c.abs());
-            }
             criterion = if amp > 0.0 { diff / amp } else { 0.0 };
             below = if criterion < tolerance { below + 1 } else { 0 };
             if below >= 2 {
@@ -195,11 +195,6 @@ pub(crate) fn run_until_periodic(
                 });
             }
         }
-        std::mem::swap(&mut previous, &mut current);
     }
     Err(TimesimError::NotPeriodic { frequency_hz, periods: max_periods, criterion, tolerance })
-}
-
-fn scheme_alpha(integrator: &Integrator) -> (f64, f64, f64) {
-    integrator.parameters()
 }
