@@ -170,3 +170,27 @@ fn paper_form_stiffness_along_a_relative_direction() {
     law.update(&[1.0], &[0.0], &mut state, &mut g, None);
     assert_eq!(g[0], 5.0 - 2.0e4);
 }
+
+#[test]
+fn a_vector_of_the_wrong_length_is_rejected() {
+    let msg = build_error(&broken("between = [\"a\", \"b\"]", "vector = [1.0, 0.0, 0.0]"));
+    assert_eq!(msg, "study.toml:16:10: [[joint]] \"j1\": vector has 3 values, expected 2 (one per DOF of the model)");
+}
+
+#[test]
+fn names_must_suit_column_names() {
+    let msg = parse_error(&broken("name = \"j1\"", "name = \"j 1,x\""));
+    assert!(
+        msg.starts_with("study.toml:14:8: [[joint]]: name \"j 1,x\" must be non-empty and use only ASCII"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn several_loads_need_the_excitation_to_name_one() {
+    let text = broken("[excitation]", "[[load]]\nname = \"pull\"\ndof = \"b\"\n\n[excitation]");
+    let msg = parse_error(&text);
+    assert!(msg.contains("[excitation]: say which [[load]] excites the structure"), "{msg}");
+    let msg = parse_error(&text.replace("levels = [1.0, 2.0]", "load = \"shove\"\nlevels = [1.0, 2.0]"));
+    assert!(msg.contains("no [[load]] named \"shove\" (loads are: push, pull)"), "{msg}");
+}
