@@ -2,7 +2,7 @@
 # Runs every pyHarm peer measurement and keeps the printed reports in results/.
 # Needs pyHarm in a throwaway virtualenv (not a project dependency):
 #   python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install pyharm-os==1.2.2
-# Usage: bash bench/peer/run_all.sh [PYTHON]   (takes about 40 minutes on the 2-core machine)
+# Usage: bash bench/peer/run_all.sh [PYTHON]   (about 50 minutes on the loaded 2-core machine)
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${1:-/tmp/pyharm-venv/bin/python}
@@ -15,12 +15,17 @@ $ONE "$PY" pyharm_table6.py > results/table6_one_core.txt
 # Same sweep with pyHarm's plain Newton-Raphson solver (iterations = Newton iterations).
 $ONE "$PY" pyharm_table6.py --solver NewtonRaphson --csv results/pyharm_table6_newton_frf.csv \
     > results/table6_one_core_newton.txt
+# Coarser steps: about the number of points of stickslip's default steps.
+$ONE "$PY" pyharm_table6.py --ds 0.2 --csv results/pyharm_table6_frf_ds0.2.csv > results/table6_one_core_ds0.2.txt
 
 # 10-DOF chain, 20-35 Hz: full harmonic system and pyHarm's condensation onto the Jenkins DOFs.
 $ONE "$PY" pyharm_chain.py > results/chain_one_core.txt
 $ONE "$PY" pyharm_chain.py --reductor NLdofs --csv /tmp/pyharm_chain_condensed.csv \
     > results/chain_one_core_condensed.txt
 "$PY" pyharm_chain.py --runs 3 --csv /tmp/pyharm_chain_default.csv > results/chain_default_threads.txt
+for ds in 0.1 0.2; do
+    $ONE "$PY" pyharm_chain.py --ds $ds --csv results/pyharm_chain_frf_ds$ds.csv > results/chain_one_core_ds$ds.txt
+done
 
 # 137 DOFs: a whole sweep takes hours, so time the first 10 continuation points, once, from the
 # band's lower end (stuck) and from 200 Hz (slipping, near the peak).
