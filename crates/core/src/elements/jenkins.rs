@@ -78,6 +78,26 @@ impl Element for Jenkins {
         }
     }
 
+    /// When the motion's range exceeds `2 F_c / k`, the slider slips in both directions every
+    /// period, and at the period's largest displacement it has just slipped forward: `f = F_c`,
+    /// `w = u_max − F_c/k`, whatever happened before.
+    fn periodic_start(&self, u: &[f64], n_t: usize, state: &mut [f64], dstate_du: &mut [f64]) -> Option<usize> {
+        let u = &u[..n_t];
+        let (mut j_max, mut u_min) = (0, u[0]);
+        for (j, &x) in u.iter().enumerate() {
+            if x > u[j_max] {
+                j_max = j;
+            }
+            u_min = u_min.min(x);
+        }
+        if self.stiffness * (u[j_max] - u_min) <= 2.0 * self.threshold {
+            return None;
+        }
+        state[0] = u[j_max] - self.threshold / self.stiffness;
+        dstate_du[0] = 1.0;
+        Some(j_max)
+    }
+
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>) {
         let (k, fc) = (self.stiffness, self.threshold);
         let trial = k * (u[0] - state[0]);

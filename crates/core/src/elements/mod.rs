@@ -115,6 +115,15 @@ pub trait Element: Send + Sync + std::fmt::Debug {
     /// ever makes non-zero.
     fn update(&self, u: &[f64], v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>);
 
+    /// A sample of the periodic motion `u` (`u[a·n_t + j]`, `n_t` samples per period) at which
+    /// the law's periodic-regime state is known from the motion alone, with that state (the
+    /// state *after* the update at that sample) and its derivative with respect to `u` there
+    /// (row-major `s × d`). Marching one period from there gives the periodic regime at once;
+    /// `None` (the default) means: march from [`Element::initial_state`] until periodic.
+    fn periodic_start(&self, _u: &[f64], _n_t: usize, _state: &mut [f64], _dstate_du: &mut [f64]) -> Option<usize> {
+        None
+    }
+
     /// Stiffness of the linear model that the element replaces (paper form, Eq. 11: `k_J`), so
     /// that the joint's own force is `f = g + k_J u`; 0 for elements that add to the model.
     fn replaced_stiffness(&self) -> f64 {

@@ -4,12 +4,14 @@
 //! samples, the element's incremental law is marched along them, and the force samples are
 //! projected back on the harmonics.
 //!
-//! **Hysteresis.** The force at θ = 0 depends on the past, so the law is marched over whole
-//! periods from the element's initial state (its documented stuck-mean convention) until the
-//! state at the end of a period equals the state at its start (the periodic regime; a Jenkins
-//! element that slips reaches it after one period, one that never slips is periodic from the
-//! start); only the last period is kept. At most [`MAX_PERIODS`] periods are marched; more means
-//! the law has no periodic regime for this motion, which is reported.
+//! **Hysteresis.** The force at θ = 0 depends on the past. When the law knows its periodic
+//! state at some sample from the motion alone ([`Element::periodic_start`]: a Jenkins slider
+//! that slips both ways has just slipped forward at the largest displacement), one period is
+//! marched from there. Otherwise the law is marched over whole periods from its initial state
+//! (its documented stuck-mean convention) until the state at the end of a period equals the
+//! state at its start, and the last period is kept (one that never slips is periodic from the
+//! start). At most [`MAX_PERIODS`] periods are marched; more means the law has no periodic
+//! regime for this motion, which is reported.
 //!
 //! **Jacobian.** By forward differentiation through the recursion: with `S_j = ∂state_j/∂X`,
 //!
@@ -67,6 +69,7 @@ pub struct ElementAft {
     ds0: Vec<f64>,
     state_before: Vec<f64>,
     state_period_start: Vec<f64>,
+    state_after_start: Vec<f64>,
     tangent: Tangent,
     /// `S` before and after an update, row-major `s × (nc·d + 1)`.
     sens: Vec<f64>,
@@ -103,6 +106,7 @@ impl ElementAft {
             ds0: vec![0.0; s * d],
             state_before: vec![0.0; s],
             state_period_start: vec![0.0; s],
+            state_after_start: vec![0.0; s],
             tangent: Tangent::new(d, s),
             sens: vec![0.0; s * cols],
             sens_next: vec![0.0; s * cols],
@@ -143,14 +147,21 @@ impl ElementAft {
             }
         }
         let want_jac = jacobian.is_some();
-        let e0 = plan.basis_at(0);
         let velocity = law.depends_on_velocity();
         let cols = nc * d + 1;
 
-        // Initial state and its sensitivity to X through u(θ_0) = E_0 X.
-        self.load_sample(0);
-        law.initial_state(&self.u_now, &mut self.state, want_jac.then_some(&mut self.ds0[..]));
+        // Where the march starts, in which state, and the state's sensitivity to X through
+        // u(θ_j0) = E_j0 X: at a sample where the law knows its periodic state (one period then
+        // suffices), else at θ = 0 from the law's initial-state convention.
+        let hysteretic = s > 0;
+        let known = if hysteretic { law.periodic_start(&self.u, nt, &mut self.state, &mut self.ds0) } else { None };
+        let j0 = known.unwrap_or(0);
+        if known.is_none() {
+            self.load_sample(0);
+            law.initial_state(&self.u_now, &mut self.state, want_jac.then_some(&mut self.ds0[..]));
+        }
         if want_jac {
+            let e0 = plan.basis_at(j0);
             self.sens.iter_mut().for_each(|v| *v = 0.0);
             for m in 0..s {
                 for a in 0..d {
@@ -165,12 +176,12 @@ impl ElementAft {
         }
 
         // March whole periods until the state repeats; keep the last one.
-        let hysteretic = s > 0;
         let mut period = 0;
         loop {
             period += 1;
             self.state_period_start.copy_from_slice(&self.state);
-            for j in 0..nt {
+            for i in 0..nt {
+                let j = (j0 + i) % nt;
                 self.load_sample(j);
                 self.state_before.copy_from_slice(&self.state);
                 law.update(
@@ -187,8 +198,16 @@ impl ElementAft {
                 if want_jac {
                     self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
                 }
+                if i == 0 {
+                    self.state_after_start.copy_from_slice(&self.state);
+                }
             }
             if !hysteretic {
+                break;
+            }
+            if known.is_some() {
+                // The step into the start sample is the one from the period's last state.
+                self.slipping[j0] = law.is_slipping(&self.state, &self.state_after_start);
                 break;
             }
             let scale = self.state_period_start.iter().chain(&self.state).fold(0.0f64, |m, x| m.max(x.abs()));
@@ -355,8 +374,9 @@ mod tests {
             assert!(((c1 - a1) / a1).abs() < 1e-3, "a1 {c1} vs {a1}");
             assert!(((s1 - b1) / b1).abs() < 1e-3, "b1 {s1} vs {b1}");
             assert!(((wa - w) / w).abs() < 1e-3, "W {wa} vs {w}");
-            // Slipping: periodic after the first period of the march.
-            assert_eq!(aft.periods, 2);
+            // Slipping in both directions: the periodic state is known at the largest
+            // displacement, one period suffices.
+            assert_eq!(aft.periods, 1);
         }
     }
 
@@ -429,6 +449,52 @@ mod tests {
         for row in 0..n {
             let fd = (gp[row] - gm[row]) / (2.0 * hw);
             assert!((fd - dgdw[row]).abs() * omega < tol * gscale, "{}: dG/dΩ row {row}", law.kind());
+        }
+    }
+
+    /// The same law without its periodic-start shortcut: marched from rest until periodic.
+    #[derive(Debug)]
+    struct Marched(Jenkins);
+
+    impl Element for Marched {
+        fn kind(&self) -> &'static str {
+            "marched"
+        }
+        fn n_state(&self) -> usize {
+            1
+        }
+        fn initial_state(&self, u0: &[f64], state: &mut [f64], d: Option<&mut [f64]>) {
+            self.0.initial_state(u0, state, d)
+        }
+        fn update(&self, u: &[f64], v: &[f64], state: &mut [f64], g: &mut [f64], t: Option<&mut Tangent>) {
+            self.0.update(u, v, state, g, t)
+        }
+    }
+
+    #[test]
+    fn one_period_from_the_known_start_equals_the_march_to_the_periodic_regime() {
+        let plan = AftPlan::new(5, 256).unwrap();
+        let n = plan.n_coeffs();
+        for amplitude in [2e-4, 1e-3] {
+            let law = Jenkins::replacing_stiffness(1e6, 100.0).unwrap();
+            let marched = Marched(law.clone());
+            let u = motion(amplitude);
+            let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
+            let (mut j1, mut j2) = (Mat::zeros(n, n), Mat::zeros(n, n));
+            let (mut w1, mut w2) = (vec![0.0; n], vec![0.0; n]);
+            let mut a1 = ElementAft::new(&law, &plan);
+            let mut a2 = ElementAft::new(&marched, &plan);
+            a1.evaluate(&law, &plan, 500.0, &u, &mut g1, Some((j1.as_mut(), &mut w1))).unwrap();
+            a2.evaluate(&marched, &plan, 500.0, &u, &mut g2, Some((j2.as_mut(), &mut w2))).unwrap();
+            assert_eq!((a1.periods, a2.periods), (1, 2));
+            let gs = g2.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for i in 0..n {
+                assert!((g1[i] - g2[i]).abs() < 1e-12 * gs);
+                for j in 0..n {
+                    assert!((j1[(i, j)] - j2[(i, j)]).abs() < 1e-9 * 1e6);
+                }
+            }
+            assert_eq!(a1.slipping, a2.slipping);
         }
     }
 
