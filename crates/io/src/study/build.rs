@@ -41,22 +41,18 @@ impl Study {
     /// Read the matrix files (if any), check the model (sizes, symmetry, M positive definite by
     /// a Cholesky factorisation) and build the nonlinear model, the excitation and the outputs.
     pub fn build_model(&self) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
-        let err = |at: Location, kind: StudyErrorKind| StudyError {
-            file: self.path.clone(),
-            location: Some(at),
-            kind: Box::new(kind),
-        };
+        let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
-        let (full, fe, model_at) = self.full_model()?;
+        let (full, model_at) = self.full_model()?;
         // Reduction (Section 3.3): the nonlinear analysis runs on the reduced model; loads,
         // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
         // u = Vᵀ U = (Tᵀ V)ᵀ q).
-        let full_dofs = full.dofs.clone();
+        let full_dofs = full.linear().dofs.clone();
         let (mut linear, reduction) = match &self.reduction {
-            None => (full, None),
+            None => (full.into_linear(), None),
             Some(r) => {
-                let releases = self.releases(&full)?;
-                let red = reduce(&full, fe.as_ref(), r, &releases).map_err(|k| err(r.at, k))?;
+                let releases = self.releases(full.linear())?;
+                let red = reduce(&full, r, &releases).map_err(|k| err(r.at, k))?;
                 (red.model.clone(), Some(red))
             }
         };
@@ -88,14 +84,13 @@ impl Study {
 
         let outputs = if self.outputs.is_empty() {
             if linear.n_dofs() > MAX_DEFAULT_OUTPUTS {
-                return Err(StudyError {
-                    file: self.path.clone(),
-                    location: None,
-                    kind: Box::new(StudyErrorKind::Invalid(format!(
+                return Err(self.error(
+                    None,
+                    StudyErrorKind::Invalid(format!(
                         "[[output]]: the model has {} DOFs; say which to report with [[output]] sections (every DOF is reported by default only up to {MAX_DEFAULT_OUTPUTS})",
                         linear.n_dofs()
-                    ))),
-                });
+                    )),
+                ));
             }
             (0..linear.n_dofs())
                 .map(|i| OutputSpec {
@@ -117,14 +112,14 @@ impl Study {
         Ok((model, excitation, outputs))
     }
 
+    fn error(&self, location: Option<Location>, kind: StudyErrorKind) -> StudyError {
+        StudyError { file: self.path.clone(), location, kind: Box::new(kind) }
+    }
+
     /// The model as given (before any reduction), checked: M positive definite; inline and
     /// file models also for sizes and symmetry (assembled meshes are symmetric by construction).
-    fn full_model(&self) -> Result<(LinearModel, Option<FeModel>, ModelLocations), StudyError> {
-        let err = |at: Location, kind: StudyErrorKind| StudyError {
-            file: self.path.clone(),
-            location: Some(at),
-            kind: Box::new(kind),
-        };
+    fn full_model(&self) -> Result<(FullModel, ModelLocations), StudyError> {
+        let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
         let damping = |at: Location| -> Result<Damping, StudyError> {
             Ok(match &self.damping {
@@ -158,8 +153,7 @@ impl Study {
                 let mut fe = read_mesh(path, material.as_ref()).map_err(|k| err(at.mass, k))?;
                 fe.model.damping = damping(at.section)?;
                 check_mass_positive_definite(&fe.model.mass).map_err(|e| err(at.mass, model_error(e)))?;
-                let model = fe.model.clone();
-                return Ok((model, Some(fe), *at));
+                return Ok((FullModel::Mesh(fe), *at));
             }
         };
         // Point at the matrix a model error is about.
@@ -184,17 +178,13 @@ impl Study {
         let linear = LinearModel::new(mass, stiffness, damping(at.section)?, dofs, Vec::new())
             .map_err(|e| err(error_at(&e), model_error(e)))?;
         check_mass_positive_definite(&linear.mass).map_err(|e| err(error_at(&e), model_error(e)))?;
-        Ok((linear, None, at))
+        Ok((FullModel::Matrices(linear), at))
     }
 
     /// The joints that replace stiffness of the full model, as releases for the enriched
     /// reduction (their connector `k d dᵀ` removed from K).
     fn releases(&self, full: &LinearModel) -> Result<Vec<Release>, StudyError> {
-        let err = |at: Location, kind: StudyErrorKind| StudyError {
-            file: self.path.clone(),
-            location: Some(at),
-            kind: Box::new(kind),
-        };
+        let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
         let space = DofSpace { dofs: &full.dofs, reduction: None };
         let mut out = Vec::new();
         for j in &self.joints {
@@ -309,6 +299,37 @@ fn check_slipped_stiffness(
     Ok(())
 }
 
+/// The model before reduction; a mesh keeps its assembly, which knows the node sets.
+// One value per build, moved once: the size difference of the variants costs nothing.
+#[allow(clippy::large_enum_variant)]
+enum FullModel {
+    Matrices(LinearModel),
+    Mesh(FeModel),
+}
+
+impl FullModel {
+    fn linear(&self) -> &LinearModel {
+        match self {
+            FullModel::Matrices(m) => m,
+            FullModel::Mesh(fe) => &fe.model,
+        }
+    }
+
+    fn fe(&self) -> Option<&FeModel> {
+        match self {
+            FullModel::Matrices(_) => None,
+            FullModel::Mesh(fe) => Some(fe),
+        }
+    }
+
+    fn into_linear(self) -> LinearModel {
+        match self {
+            FullModel::Matrices(m) => m,
+            FullModel::Mesh(fe) => fe.model,
+        }
+    }
+}
+
 /// The DOFs that loads, joints and outputs name (those of the full model), and the reduction
 /// that maps their vectors to the analysed model.
 struct DofSpace<'a> {
@@ -395,12 +416,8 @@ fn read_mesh(path: &Path, material: Option<&MaterialSpec>) -> Result<FeModel, St
 }
 
 /// The reduction of `[reduction]`: retained DOFs from node sets (mesh) or DOF names.
-fn reduce(
-    full: &LinearModel,
-    fe: Option<&FeModel>,
-    spec: &ReductionSpec,
-    releases: &[Release],
-) -> Result<Reduction, StudyErrorKind> {
+fn reduce(full: &FullModel, spec: &ReductionSpec, releases: &[Release]) -> Result<Reduction, StudyErrorKind> {
+    let (fe, full) = (full.fe(), full.linear());
     const CTX: &str = "[reduction] retain";
     let space = DofSpace { dofs: &full.dofs, reduction: None };
     let mut retained: Vec<usize> = Vec::new();
