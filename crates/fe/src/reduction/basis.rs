@@ -249,7 +249,9 @@ pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduct
     finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
 }
 
-type StaticAndFree = (Partition, Mat<f64>, EigenSolution, Vec<(&'static str, f64)>);
+/// Wall-clock seconds per named stage.
+type Stages = Vec<(&'static str, f64)>;
+type StaticAndFree = (Partition, Mat<f64>, EigenSolution, Stages);
 
 /// Constraint modes and the free modes. When no shift is asked and K is positive definite, a
 /// single LDLᵀ of K serves both (shift 0 is then below the spectrum); otherwise (a free-free
@@ -291,7 +293,7 @@ fn static_part(
     model: &LinearModel,
     k: &SparseColMat<usize, f64>,
     retained: &[usize],
-) -> Result<(Partition, Mat<f64>, Vec<(&'static str, f64)>), ReductionError> {
+) -> Result<(Partition, Mat<f64>, Stages), ReductionError> {
     let part = partition(model, retained)?;
     let start = Instant::now();
     let kee = interior_block(k, &part);

@@ -67,9 +67,15 @@ fn cards(text: &str) -> Vec<Card> {
     out
 }
 
+/// A DOF as (grid, component).
+type Dof = (u64, u8);
+
+/// A term: source line, row DOF, column DOF, value.
+type Term = (usize, Dof, Dof, f64);
+
 struct Pending {
     symmetric: bool,
-    entries: Vec<(usize, (u64, u8), (u64, u8), f64)>,
+    entries: Vec<Term>,
 }
 
 /// Read every DMIG matrix of a punch or bulk data file.
@@ -150,10 +156,10 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
     let mut out = Vec::new();
     for name in order {
         let p = matrices.remove(&name).expect("listed");
-        let mut keys: Vec<(u64, u8)> = p.entries.iter().flat_map(|e| [e.1, e.2]).collect();
+        let mut keys: Vec<Dof> = p.entries.iter().flat_map(|e| [e.1, e.2]).collect();
         keys.sort_unstable();
         keys.dedup();
-        let index = |k: &(u64, u8)| keys.binary_search(k).expect("every key is listed");
+        let index = |k: &Dof| keys.binary_search(k).expect("every key is listed");
         let n = keys.len();
         let matrix = if p.symmetric {
             let mut t = SymmetricTriplets::default();
