@@ -4,7 +4,7 @@
 
 use super::records::{CycleEnergy, Records};
 use super::steady::{check_frequency, check_steps, run_until_periodic};
-use super::{Integrator, Scheme, State, TimesimError};
+use super::{EnergyTally, Integrator, Scheme, State, TimesimError};
 use crate::model::NonlinearModel;
 
 /// What to compute.
@@ -57,7 +57,8 @@ pub struct SweepCycle {
     /// First-harmonic coefficients `(c1, s1)` of each recorded DOF's displacement against the
     /// excitation phase, `x ≈ c1 cos φ + s1 sin φ`: `(1/π) ∮ x (cos φ, sin φ) dφ`.
     pub harmonic1: Vec<(f64, f64)>,
-    /// Energy over the steps whose end falls in the cycle.
+    /// Energy over the cycle (the tallies interpolated linearly inside the steps where the
+    /// cycle starts and ends).
     pub energy: CycleEnergy,
 }
 
@@ -117,6 +118,10 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
     let mut acc = vec![(0.0, 0.0); n_rec];
     let mut cycle_start = 0.0;
     let mut cycle_tally = state.energy.clone();
+    // Tally before the current step, and at the cycle boundary inside it (interpolated
+    // linearly within the step, so that a cycle's energy is not off by a fraction of a step).
+    let mut step_tally = state.energy.clone();
+    let mut boundary_tally = state.energy.clone();
     let mut cycle_index = 0usize;
     let mut x_prev: Vec<f64> = options.record_dofs.iter().map(|&i| state.displacement[i]).collect();
     let mut phi_prev = 0.0;
@@ -126,6 +131,7 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
             frequency_hz.push(f0 + rate * state.time);
         }
         let t_end = (k + 1) as f64 * step;
+        copy_tally(&state.energy, &mut step_tally);
         integrator.step(&mut state, load, phase(t_end + alpha * step).cos(), phase(t_end).cos())?;
         state.time = t_end;
         // Trapezoidal ∫ x (cos φ, sin φ) dφ over the step, split where φ crosses a cycle end
@@ -156,9 +162,12 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
                     frequency_hz: f0 + rate * t_mid,
                     start_time: cycle_start,
                     harmonic1: acc.iter().map(|&(c, s)| (c / pi, s / pi)).collect(),
-                    energy: CycleEnergy::between(&cycle_tally, &state.energy),
+                    energy: {
+                        interpolate_tally(&step_tally, &state.energy, hi_frac, &mut boundary_tally);
+                        CycleEnergy::between(&cycle_tally, &boundary_tally)
+                    },
                 });
-                cycle_tally = state.energy.clone();
+                copy_tally(&boundary_tally, &mut cycle_tally);
                 acc.iter_mut().for_each(|a| *a = (0.0, 0.0));
                 cycle_start = t_boundary;
                 cycle_index += 1;
@@ -172,4 +181,19 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
         phi_prev = phi;
     }
     Ok(SweepRecord { step, records, frequency_hz, cycles, final_state: state })
+}
+
+fn copy_tally(from: &EnergyTally, to: &mut EnergyTally) {
+    to.input = from.input;
+    to.viscous = from.viscous;
+    to.elements.copy_from_slice(&from.elements);
+}
+
+/// `out = a + λ (b − a)`.
+fn interpolate_tally(a: &EnergyTally, b: &EnergyTally, lambda: f64, out: &mut EnergyTally) {
+    out.input = a.input + lambda * (b.input - a.input);
+    out.viscous = a.viscous + lambda * (b.viscous - a.viscous);
+    for ((o, x), y) in out.elements.iter_mut().zip(&a.elements).zip(&b.elements) {
+        *o = x + lambda * (y - x);
+    }
 }
