@@ -1,0 +1,63 @@
+//! `stickslip run` end to end on the shipped examples and on bad input.
+use std::path::PathBuf;
+use std::process::Command;
+
+fn stickslip() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_stickslip"))
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("stickslip-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn the_1dof_example_writes_an_frf_table_covering_the_band_at_every_level() {
+    let out = scratch("1dof");
+    let status = stickslip()
+        .args(["run", "--quiet", "--out"])
+        .arg(&out)
+        .arg(repo().join("examples/jenkins-1dof/study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[..2], &["level_N", "frequency_Hz"]);
+    let accel = header.iter().position(|h| *h == "mass_accel_frf_m_s2_per_N").expect("acceleration FRF column");
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    for level in [100.0, 1000.0, 3000.0, 10000.0] {
+        let f: Vec<f64> = rows.iter().filter(|r| r[0] == level).map(|r| r[1]).collect();
+        assert!(f.len() > 20, "level {level}: {} points", f.len());
+        // The branch starts and ends exactly on the band's limits.
+        assert_eq!(f[0], 150.0);
+        assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
+    }
+    // Far below resonance the response is linear and stuck: |H| = Ω²/|k − MΩ² + iΩd|.
+    let first = &rows[0];
+    let w = 2.0 * std::f64::consts::PI * 150.0;
+    let expected = w * w / ((2.24e7 - 10.0 * w * w).powi(2) + (350.0 * w).powi(2)).sqrt();
+    assert!((first[accel] - expected).abs() < 1e-6 * expected, "{} vs {expected}", first[accel]);
+    assert!(out.join("frf.npz").exists());
+    assert!(out.join("frf_mass.png").exists());
+}
+
+#[test]
+fn a_bad_study_is_refused_with_the_file_line_and_key() {
+    let out = scratch("bad");
+    std::fs::create_dir_all(&out).unwrap();
+    let study = out.join("bad.toml");
+    let text = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml")).unwrap();
+    std::fs::write(&study, text.replace("threshold = 1000.0", "threshold = -5.0")).unwrap();
+    let output = stickslip().args(["run", "--quiet", "--out"]).arg(&out).arg(&study).output().unwrap();
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains("bad.toml:"), "{message}");
+    assert!(message.contains("threshold"), "{message}");
+}
