@@ -154,7 +154,7 @@ def coupled_deck():
 
 
 if __name__ == "__main__":
-    for kind, cells in [("C3D4", (8, 2, 2)), ("C3D10", (4, 1, 1)), ("C3D8", (8, 2, 2)), ("C3D20", (4, 1, 1)),
-                        ("C3D20R", (4, 1, 1))]:
+    for kind, cells in [("C3D4", (8, 2, 2)), ("C3D10", (5, 2, 2)), ("C3D8", (10, 2, 2)), ("C3D20", (5, 2, 2)),
+                        ("C3D20R", (5, 2, 2))]:
         clamped_deck(kind, cells)
     coupled_deck()

@@ -2,11 +2,9 @@
 //! its regenerate.sh): our first 10 frequencies agree to 1e-4 relative, and our K and M equal
 //! CalculiX's exported matrices entry by entry.
 //!
-//! The decks stay under ~250 equations: above that, the frequencies CalculiX 2.20 (Debian
-//! build) prints drift from the eigenvalues of the very matrices it exports for the same deck
-//! (e.g. a 270-equation C3D8 block: 8e-4 on mode 1, while its exported K and M equal ours to
-//! 1e-14 and give our frequencies), so larger decks would test CalculiX's eigensolver, not
-//! the model.
+//! Frequencies come from `element_support::dense_frequencies` (eigenvalues only): faer 0.24's
+//! `self_adjoint_eigen` with eigenvectors returned a wrong lowest eigenpair on the 270-DOF C3D8
+//! block (8e-4 off in frequency), which `LinearModel::dense_modes` inherits.
 
 mod element_support;
 
@@ -50,9 +48,9 @@ fn compare_frequencies(name: &str) {
     for (a, b) in ours.iter().zip(&theirs) {
         println!("  {a:12.4} Hz  CalculiX {b:12.4} Hz");
     }
-    // CalculiX prints 7 significant digits (5e-8); the element decks agree to ~3e-7, the
-    // coupled deck to ~1e-5 (CalculiX carries the reference rotations on an extra node).
-    assert!(worst < 1e-4, "{name}: frequencies differ by {worst:.3e} relative");
+    // The issue asks for 1e-4. CalculiX prints 7 significant digits (5e-8) and its ARPACK
+    // stops at ~4e-7 here: 1e-6 holds with margin and catches any element-level change.
+    assert!(worst < 1e-6, "{name}: frequencies differ by {worst:.3e} relative");
 }
 
 fn compare_matrices(name: &str) {
