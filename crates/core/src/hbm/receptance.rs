@@ -59,6 +59,10 @@ pub struct DirectReceptance {
     rhs: Mat<c64>,
 }
 
+/// Output selectors prepared by [`Receptance::outputs`].
+#[derive(Clone, Debug)]
+pub struct Outputs(Vec<Vec<f64>>);
+
 /// Complex receptance of one harmonic and its derivative with respect to ω.
 pub struct HarmonicReceptance {
     /// `H` (q × q).
@@ -139,11 +143,30 @@ impl Receptance {
         }
     }
 
+    /// Prepare output selectors `o` (each of length n) for [`recover`](Self::recover): their
+    /// modal projections `Φᵀ o` once, rather than at every harmonic of every point.
+    pub fn outputs(&self, outputs: &[&[f64]]) -> Outputs {
+        match self {
+            Receptance::Modal(m) => {
+                let phi = &m.modes.shapes;
+                Outputs(
+                    outputs
+                        .iter()
+                        .map(|o| {
+                            (0..phi.ncols()).map(|r| o.iter().enumerate().map(|(l, v)| v * phi[(l, r)]).sum()).collect()
+                        })
+                        .collect(),
+                )
+            }
+            Receptance::Direct(_) => Outputs(outputs.iter().map(|o| o.to_vec()).collect()),
+        }
+    }
+
     /// Recovery (Eq. 27): complex amplitude at harmonic frequency `omega` along each of
     /// `outputs` of `U = Z⁻¹ (level F − V G)`, with `G` the complex force amplitudes on the q
     /// directions (`g_c − i g_s`). Also the viscous power term: returns
     /// `(amplitudes, Uᴴ D U)` where `U` is the full response.
-    pub fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+    pub fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &Outputs) -> (Vec<c64>, f64) {
         match self {
             Receptance::Modal(m) => m.recover(omega, level, g, outputs),
             Receptance::Direct(d) => d.recover(omega, level, g, outputs),
@@ -183,11 +206,10 @@ impl ModalReceptance {
         }
     }
 
-    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &Outputs) -> (Vec<c64>, f64) {
         let q = self.a.nrows();
         let m = self.omega_r.len();
-        let phi = &self.modes.shapes;
-        let mut amps = vec![c64::new(0.0, 0.0); outputs.len()];
+        let mut amps = vec![c64::new(0.0, 0.0); outputs.0.len()];
         let mut dissipation = 0.0;
         for r in 0..m {
             let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
@@ -198,9 +220,8 @@ impl ModalReceptance {
             let coord = load / den;
             // Modal viscous term: φ_rᵀ D φ_r = c_r (mass-normalised modes).
             dissipation += self.c_r[r] * coord.norm_sqr();
-            for (amp, o) in amps.iter_mut().zip(outputs) {
-                let p: f64 = o.iter().enumerate().map(|(l, v)| v * phi[(l, r)]).sum();
-                *amp += coord * p;
+            for (amp, o) in amps.iter_mut().zip(&outputs.0) {
+                *amp += coord * o[r];
             }
         }
         (amps, dissipation)
@@ -242,7 +263,7 @@ impl DirectReceptance {
         }
     }
 
-    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &[&[f64]]) -> (Vec<c64>, f64) {
+    fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &Outputs) -> (Vec<c64>, f64) {
         let n = self.mass.nrows();
         let q = self.rhs.ncols() - 1;
         let load = Mat::from_fn(n, 1, |l, _| {
@@ -253,7 +274,7 @@ impl DirectReceptance {
             v
         });
         let u = self.dynamic_stiffness(omega).partial_piv_lu().solve(&load);
-        let amps = outputs.iter().map(|o| (0..n).map(|l| u[(l, 0)] * o[l]).sum()).collect();
+        let amps = outputs.0.iter().map(|o| (0..n).map(|l| u[(l, 0)] * o[l]).sum()).collect();
         let mut dissipation = 0.0;
         for i in 0..n {
             for j in 0..n {

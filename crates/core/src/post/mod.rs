@@ -106,17 +106,18 @@ pub fn evaluate_point(
     let force = hbm.force().to_vec();
     let mut selectors: Vec<&[f64]> = outputs.iter().map(|o| o.vector.as_slice()).collect();
     selectors.push(&force);
+    let prepared = hbm.receptance().outputs(&selectors);
     let mut coeffs = vec![vec![0.0; nc]; selectors.len()];
     let mut viscous = 0.0;
     let g0: Vec<c64> = (0..q).map(|i| c64::new(g[i], 0.0)).collect();
-    let (mean, _) = hbm.receptance().recover(0.0, 0.0, &g0, &selectors);
+    let (mean, _) = hbm.receptance().recover(0.0, 0.0, &g0, &prepared);
     for (c, m) in coeffs.iter_mut().zip(&mean) {
         c[0] = m.re;
     }
     for k in 1..=nh {
         let gk: Vec<c64> = (0..q).map(|i| complex_amplitude(&g, q, k, i)).collect();
         let lk = if k == 1 { level } else { 0.0 };
-        let (amps, udu) = hbm.receptance().recover(k as f64 * omega, lk, &gk, &selectors);
+        let (amps, udu) = hbm.receptance().recover(k as f64 * omega, lk, &gk, &prepared);
         // ∫₀ᵀ U̇ᵀ D U̇ dt = π Ω Σ_k k² Uᴴ D U.
         viscous += pi * omega * (k * k) as f64 * udu;
         for (c, a) in coeffs.iter_mut().zip(&amps) {
