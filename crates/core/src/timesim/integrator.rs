@@ -40,7 +40,7 @@
 //! reversal inside a slipping step leaves the slider off by O(h²), and the next slip resets it
 //! (`w = u ∓ F_c/k`), so errors do not accumulate: the slider does not drift.
 
-use super::operator::{effective_solver, mass_solver, LinearOperators, SpdSolver};
+use super::operator::{effective_solver, mass_solver, LinearOperators, Operator, SpdSolver};
 use super::TimesimError;
 use crate::elements::Tangent;
 use crate::model::NonlinearModel;
@@ -108,7 +108,7 @@ pub struct State {
     pub energy: EnergyTally,
     /// Value of the excitation's time function at `time`.
     excitation: f64,
-    /// Cached `D v` at `time`, and `K u` (kept current only for HHT, the one scheme that uses it).
+    /// Cached `D v` at `time`, and `K u` (kept current only where it is used: HHT, sparse models).
     ku: Vec<f64>,
     dv: Vec<f64>,
 }
@@ -146,6 +146,7 @@ pub struct Integrator<'m> {
     c1: f64,
     operators: LinearOperators,
     solver: SpdSolver,
+    folded: Option<FoldedDense>,
     /// Application vectors, direction-major: direction `a` is `dirs[a*n..(a+1)*n]`.
     dirs: Vec<f64>,
     /// `W = S⁻¹ V`, same layout.
@@ -156,6 +157,21 @@ pub struct Integrator<'m> {
     offsets: Vec<(usize, usize)>,
     q: usize,
     work: Work,
+}
+
+/// Dense models: the solve with S folded into precomputed products,
+/// `u_lin = P_M ũ + P_D ((1+α)(c1 ũ − ṽ) + α v_n) + α P_K u_n + α W g_n + e S⁻¹F`
+/// with `P_M = c0 S⁻¹ M`, `P_D = S⁻¹ D`, `P_K = S⁻¹ K`: three n × n products per step
+/// instead of four (average acceleration), four instead of five (HHT).
+#[derive(Debug)]
+struct FoldedDense {
+    pm: Operator,
+    pd: Operator,
+    /// HHT only.
+    pk: Option<Operator>,
+    /// The load whose response `S⁻¹ F` is cached (NaN until the first step).
+    load: Vec<f64>,
+    load_response: Vec<f64>,
 }
 
 /// Scratch of a step, allocated once.
@@ -206,6 +222,19 @@ impl<'m> Integrator<'m> {
         let c1 = gamma / (beta * step);
         let operators = LinearOperators::new(lin)?;
         let mut solver = effective_solver(lin, &operators, c0, (1.0 + alpha) * c1, 1.0 + alpha)?;
+        let folded = match &solver {
+            SpdSolver::DenseInverse(inv) => {
+                let fold = |a: &faer::Mat<f64>, scale: f64| Operator::from_dense(&(faer::Scale(scale) * (inv * a)));
+                Some(FoldedDense {
+                    pm: fold(&lin.mass.to_dense(), c0),
+                    pd: fold(&operators.damping.to_dense(lin), 1.0),
+                    pk: (alpha != 0.0).then(|| fold(&lin.stiffness.to_dense(), 1.0)),
+                    load: vec![f64::NAN; n],
+                    load_response: vec![0.0; n],
+                })
+            }
+            SpdSolver::Sparse { .. } => None,
+        };
         let q = model.n_directions();
         let dirs: Vec<f64> = model.application_vectors().flat_map(|v| v.iter().copied()).collect();
         let mut w = vec![0.0; q * n];
@@ -258,7 +287,24 @@ impl<'m> Integrator<'m> {
             history_try: vec![0.0; ds],
             tangents,
         };
-        Ok(Integrator { model, step, alpha, beta, gamma, c0, c1, operators, solver, dirs, w, c, offsets, q, work })
+        Ok(Integrator {
+            model,
+            step,
+            alpha,
+            beta,
+            gamma,
+            c0,
+            c1,
+            operators,
+            solver,
+            folded,
+            dirs,
+            w,
+            c,
+            offsets,
+            q,
+            work,
+        })
     }
 
     pub fn step_size(&self) -> f64 {
@@ -399,27 +445,52 @@ impl<'m> Integrator<'m> {
         let ap = 1.0 + alpha;
         let wk = &mut self.work;
 
-        // Predictors and the right-hand side b.
+        // Predictors, then u_lin = S⁻¹ b (the solution without the element forces at t_{n+1}).
         for i in 0..n {
             let (u, v, a) = (state.displacement[i], state.velocity[i], state.acceleration[i]);
             wk.u_pred[i] = u + h * v + h * h * (0.5 - beta) * a;
             wk.v_pred[i] = v + h * (1.0 - gamma) * a;
-            wk.x[i] = c0 * wk.u_pred[i];
         }
-        self.operators.mass.apply(&wk.x, &mut wk.rhs);
-        for i in 0..n {
-            wk.x[i] = ap * (c1 * wk.u_pred[i] - wk.v_pred[i]);
-        }
-        self.operators.damp(&wk.x, &mut wk.y, &mut wk.tmp);
-        for i in 0..n {
-            wk.rhs[i] += wk.y[i] + alpha * (state.dv[i] + state.ku[i]) + excitation_eval * load[i];
-        }
-        if alpha != 0.0 {
-            for a in 0..q {
-                axpy(alpha * state.element_force[a], &self.dirs[a * n..(a + 1) * n], &mut wk.rhs);
+        if let Some(fd) = &mut self.folded {
+            if fd.load.as_slice() != load {
+                fd.load.copy_from_slice(load);
+                self.solver.solve(load, &mut fd.load_response);
             }
+            for i in 0..n {
+                wk.x[i] = ap * (c1 * wk.u_pred[i] - wk.v_pred[i]) + alpha * state.velocity[i];
+            }
+            fd.pm.apply(&wk.u_pred, &mut wk.u_lin);
+            fd.pd.apply(&wk.x, &mut wk.y);
+            for i in 0..n {
+                wk.u_lin[i] += wk.y[i] + excitation_eval * fd.load_response[i];
+            }
+            if let Some(pk) = &fd.pk {
+                pk.apply(&state.displacement, &mut wk.y);
+                axpy(alpha, &wk.y, &mut wk.u_lin);
+                for a in 0..q {
+                    axpy(alpha * state.element_force[a], &self.w[a * n..(a + 1) * n], &mut wk.u_lin);
+                }
+            }
+        } else {
+            // b = M c0 ũ + D (1+α)(c1 ũ − ṽ) + α (D v_n + K u_n + V g_n) + e F.
+            for i in 0..n {
+                wk.x[i] = c0 * wk.u_pred[i];
+            }
+            self.operators.mass.apply(&wk.x, &mut wk.rhs);
+            for i in 0..n {
+                wk.x[i] = ap * (c1 * wk.u_pred[i] - wk.v_pred[i]);
+            }
+            self.operators.damp(&wk.x, &mut wk.y, &mut wk.tmp);
+            for i in 0..n {
+                wk.rhs[i] += wk.y[i] + alpha * (state.dv[i] + state.ku[i]) + excitation_eval * load[i];
+            }
+            if alpha != 0.0 {
+                for a in 0..q {
+                    axpy(alpha * state.element_force[a], &self.dirs[a * n..(a + 1) * n], &mut wk.rhs);
+                }
+            }
+            self.solver.solve(&wk.rhs, &mut wk.u_lin);
         }
-        self.solver.solve(&wk.rhs, &mut wk.u_lin);
 
         if q > 0 {
             for a in 0..q {
@@ -519,7 +590,7 @@ impl<'m> Integrator<'m> {
         state.velocity.copy_from_slice(&wk.v_new);
         state.acceleration.copy_from_slice(&wk.a_new);
         std::mem::swap(&mut state.dv, &mut wk.dv_new);
-        if alpha != 0.0 {
+        if alpha != 0.0 && self.folded.is_none() {
             self.operators.stiffness.apply(&state.displacement, &mut state.ku);
         }
         state.excitation = excitation_end;

@@ -34,7 +34,7 @@ impl Operator {
         }
     }
 
-    fn from_dense(d: &Mat<f64>) -> Self {
+    pub(crate) fn from_dense(d: &Mat<f64>) -> Self {
         let n = d.nrows();
         let mut values = Vec::with_capacity(n * d.ncols());
         for j in 0..d.ncols() {
@@ -126,7 +126,7 @@ impl DampingOperator {
     }
 
     /// Dense D.
-    fn to_dense(&self, model: &LinearModel) -> Mat<f64> {
+    pub(crate) fn to_dense(&self, model: &LinearModel) -> Mat<f64> {
         let n = model.n_dofs();
         match self {
             DampingOperator::None => Mat::zeros(n, n),
