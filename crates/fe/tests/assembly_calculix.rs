@@ -128,3 +128,19 @@ fn rigid_coupling_springs_and_mass_match_calculix() {
     // frequencies are compared.
     compare_frequencies("coupled_c3d8");
 }
+
+/// `LinearModel::dense_modes` on the 270-DOF C3D8 block: faer 0.24.4's `self_adjoint_eigen`
+/// (eigenvalues with vectors) returns a lowest frequency 8e-4 above CalculiX's and above the
+/// Rayleigh quotient of CalculiX's own mode shape, which eigenvalues-only and inverse
+/// iteration reproduce. Ignored until the dense eigensolver is fixed or checked by residuals;
+/// run with `cargo test -p stickslip-fe --test assembly_calculix -- --ignored`.
+#[test]
+#[ignore]
+fn dense_modes_match_calculix_on_the_hex8_block() {
+    let fe = FeModel::assemble(inp::read(reference("block_c3d8.inp")).unwrap()).unwrap();
+    let modes = fe.model.dense_modes().unwrap();
+    let theirs = read_frequencies("block_c3d8");
+    let ours = modes.frequencies_hz();
+    let worst = ours.iter().zip(&theirs).map(|(a, b)| (a / b - 1.0).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-6, "dense_modes differs from CalculiX by {worst:.3e} relative");
+}
