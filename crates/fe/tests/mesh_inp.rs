@@ -102,3 +102,9 @@ fn missing_include_file_is_named() {
     let e = inp::parse("*INCLUDE, INPUT=/nonexistent/mesh.inp\n", "bad.inp").unwrap_err();
     assert!(matches!(e, MeshError::Io { .. }) && e.to_string().contains("/nonexistent/mesh.inp"), "{e}");
 }
+
+#[test]
+fn point_element_without_property_card_is_named() {
+    let e = error_of(&format!("{NODES}*ELEMENT, TYPE=MASS, ELSET=SHAKER\n9, 1\n"));
+    assert!(e.contains("bad.inp:7") && e.contains("element 9") && e.contains("\"SHAKER\""), "{e}");
+}

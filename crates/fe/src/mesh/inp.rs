@@ -154,6 +154,7 @@ struct PendingPoint {
     kind: PointKind,
     nodes: Vec<usize>,
     done: bool,
+    at: Origin,
 }
 
 struct Section {
@@ -672,7 +673,7 @@ impl Parser {
                     ElemRef::Solid(self.mesh.solids.len() - 1)
                 }
                 (None, Some((kind, _))) => {
-                    self.pending_points.push(PendingPoint { id, kind, nodes, done: false });
+                    self.pending_points.push(PendingPoint { id, kind, nodes, done: false, at: self.at(first) });
                     ElemRef::Point(self.pending_points.len() - 1)
                 }
                 _ => unreachable!(),
@@ -775,7 +776,7 @@ impl Parser {
                 .find(|(_, v)| v.iter().any(|r| matches!(r, ElemRef::Point(q) if self.pending_points[*q].id == p.id)))
                 .map(|(k, _)| k.clone())
                 .unwrap_or_default();
-            return Err(MeshError::NoProperty { at: Origin::default(), what: format!("element {}:", p.id), elset });
+            return Err(MeshError::NoProperty { at: p.at.clone(), what: format!("element {}:", p.id), elset });
         }
         for (name, refs) in &self.elsets {
             let solids: Vec<usize> =
