@@ -18,6 +18,8 @@ use crate::study::PlotFormat;
 
 const SIZE: (u32, u32) = (1000, 650);
 const FONT: &str = "sans-serif";
+/// Decades shown below the largest value on a log axis.
+const LOG_DECADES: i32 = 9;
 
 /// One curve: a label and its points.
 struct Curve {
@@ -38,9 +40,14 @@ impl Chart {
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
         let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
         root.fill(&WHITE).map_err(e)?;
-        // Log axes only take positive values: zeros (e.g. a harmonic that vanishes by symmetry)
-        // are left out rather than drawn at an arbitrary floor.
-        let keep = |&(_, y): &(f64, f64)| y.is_finite() && (!self.log_y || y > 0.0);
+        // Log axes only take positive values, and values more than LOG_DECADES decades below
+        // the largest are round-off (e.g. even harmonics of a symmetric response, ~1e-20 of
+        // the first): both are left out rather than drawn at an arbitrary floor or stretching
+        // the axis over noise.
+        let largest =
+            self.curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|y| y.is_finite()).fold(0.0, f64::max);
+        let floor = largest * 10f64.powi(-LOG_DECADES);
+        let keep = move |&(_, y): &(f64, f64)| y.is_finite() && (!self.log_y || (y > 0.0 && y >= floor));
         let all: Vec<(f64, f64)> = self.curves.iter().flat_map(|c| c.points.iter().copied().filter(keep)).collect();
         // Nothing drawable (e.g. an output the excitation does not reach, zero on a log axis):
         // an empty chart that says so, rather than no file.

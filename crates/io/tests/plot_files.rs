@@ -147,3 +147,20 @@ fn level_details_plot_the_resonance_point() {
     assert!(text.contains("at 191.0000 Hz"), "the loop is not at the resonance");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn round_off_harmonics_do_not_stretch_the_log_axis() {
+    let dir = scratch_dir("plot-roundoff");
+    let mut level = levels().remove(2);
+    for p in &mut level.points {
+        // An even harmonic of a symmetric response: round-off, ~1e-20 of the first.
+        p.outputs[0].harmonics[2].0 = 1e-25;
+    }
+    plot_harmonics(&dir.join("h.svg"), &level, "mass").unwrap();
+    let text = std::fs::read_to_string(dir.join("h.svg")).unwrap();
+    // The other harmonics span 1e-6..1e-3 m; an axis stretched to 1e-25 would label the
+    // decades 1e-2x. Labels are written on their own line.
+    assert!(text.contains("\n1e-4\n"), "expected labels missing");
+    assert!(!text.contains("\n1e-2"), "the axis reaches the round-off");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
