@@ -84,8 +84,12 @@ impl Chart {
                 .map_err(e)?;
             self.draw_curves(&mut chart, keep).map_err(e)?;
         } else {
+            // Loops and signals: a margin on both axes so that the curve does not run along
+            // the frame (FRFs keep their band as the x range).
             let pad = 0.05 * (y1 - y0).max(1e-3 * y0.abs().max(y1.abs())).max(f64::MIN_POSITIVE);
             (y0, y1) = (y0 - pad, y1 + pad);
+            let pad = 0.03 * (x1 - x0);
+            (x0, x1) = (x0 - pad, x1 + pad);
             let mut chart = chart.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?;
             chart
                 .configure_mesh()
