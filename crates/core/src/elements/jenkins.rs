@@ -98,6 +98,10 @@ impl Element for Jenkins {
         Some(j_max)
     }
 
+    fn slider_stiffness(&self) -> Option<f64> {
+        Some(self.stiffness)
+    }
+
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>) {
         let (k, fc) = (self.stiffness, self.threshold);
         let trial = k * (u[0] - state[0]);

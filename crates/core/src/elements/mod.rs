@@ -124,6 +124,14 @@ pub trait Element: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// For an elastic–perfectly-plastic slider (one direction, one state: the slider position,
+    /// rate independent, as Jenkins), its spring stiffness `k`. The harmonic balance then builds
+    /// the AFT Jacobian in closed form (see `hbm::element_aft`) instead of differentiating
+    /// sample by sample. `None` (the default): the generic chain rule.
+    fn slider_stiffness(&self) -> Option<f64> {
+        None
+    }
+
     /// Stiffness of the linear model that the element replaces (paper form, Eq. 11: `k_J`), so
     /// that the joint's own force is `f = g + k_J u`; 0 for elements that add to the model.
     fn replaced_stiffness(&self) -> f64 {
