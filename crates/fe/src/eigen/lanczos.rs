@@ -250,12 +250,12 @@ fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Ma
     }
 }
 
-/// Block shift-invert Lanczos with thick restart: blocks of `b` vectors, so that every solve
+/// Block shift-invert Lanczos without restart: blocks of `b` vectors, so that every solve
 /// with the factor serves `b` right-hand sides at once (a sparse triangular solve is bound by
 /// memory traffic through the factor: one block solve costs a few single ones), fully
 /// reorthogonalised in the M inner product. Ritz values of the projected operator, the
-/// residual estimate of each from the coupling with the next block. `None` when the block
-/// breaks down or the restarts run out (the caller falls back on single-vector Lanczos).
+/// residual estimate of each from the coupling with the next block. `None` when the
+/// subspace limit is reached before convergence (the caller falls back on thick restart).
 fn block_krylov(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
@@ -265,14 +265,12 @@ fn block_krylov(
     let n = k.nrows();
     let nev = opts.count;
     let b = nev.div_ceil(3).clamp(1, 16).min(n);
-    // Thick-restarted at four times the modes asked (memory: 2 n × 4 nev values).
     let max_dim = (4 * nev).max(nev + 40).min(n);
     let par = Par::rayon(0);
     let mut v = Mat::<f64>::zeros(n, max_dim + b);
     let mut mv = Mat::<f64>::zeros(n, max_dim + b);
     let mut h = Mat::<f64>::zeros(max_dim + b, max_dim + b);
     let mut solves = 0;
-    let mut restarts = 0;
     // Start block: OP applied to pseudo-random vectors.
     let mut w = Mat::<f64>::from_fn(n, b, |i, j| pseudo_random(i + j * n));
     let mut mw = Mat::<f64>::zeros(n, b);
@@ -324,41 +322,12 @@ fn block_krylov(
             };
             if order[..nev].iter().all(|&i| residual(i) <= opts.tolerance) {
                 let sigma = factor.shift();
-                return finish(k, m, v.as_ref(), evd.U(), &theta, &order[..nev], sigma, factor, solves, restarts, opts)
+                return finish(k, m, v.as_ref(), evd.U(), &theta, &order[..nev], sigma, factor, solves, 0, opts)
                     .map(Some);
             }
         }
-        if new_dim == dim || restarts > opts.max_restarts {
+        if new_dim == dim || new_dim > max_dim {
             return Ok(None);
-        }
-        if new_dim > max_dim {
-            // Thick restart (block Krylov-Schur): keep the best Ritz vectors, then the last
-            // block, coupled to them through H[last, ·] Y.
-            restarts += 1;
-            let keep = (nev + (dim - nev) / 2).min(dim);
-            let nb_new = new_dim - dim;
-            let y = Mat::<f64>::from_fn(dim, keep, |i, c| evd.U()[(i, order[c])]);
-            let coupling = Mat::<f64>::from_fn(nb_new, keep, |r, c| {
-                (start..dim).map(|q| h[(dim + r, q)] * evd.U()[(q, order[c])]).sum()
-            });
-            let kept_v = v.subcols(0, dim) * &y;
-            let kept_mv = mv.subcols(0, dim) * &y;
-            let last_v = v.subcols(dim, nb_new).to_owned();
-            let last_mv = mv.subcols(dim, nb_new).to_owned();
-            v.subcols_mut(0, keep).copy_from(&kept_v);
-            mv.subcols_mut(0, keep).copy_from(&kept_mv);
-            v.subcols_mut(keep, nb_new).copy_from(&last_v);
-            mv.subcols_mut(keep, nb_new).copy_from(&last_mv);
-            h.fill(0.0);
-            for c in 0..keep {
-                h[(c, c)] = theta[order[c]];
-                for r in 0..nb_new {
-                    h[(keep + r, c)] = coupling[(r, c)];
-                }
-            }
-            start = keep;
-            dim = keep + nb_new;
-            continue;
         }
         start = dim;
         dim = new_dim;
