@@ -2,7 +2,7 @@
 # Runs every pyHarm peer measurement and keeps the printed reports in results/.
 # Needs pyHarm in a throwaway virtualenv (not a project dependency):
 #   python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install pyharm-os==1.2.2
-# Usage: bash bench/peer/run_all.sh [PYTHON]   (about 50 minutes on the loaded 2-core machine)
+# Usage: bash bench/peer/run_all.sh [PYTHON]   (about 75 minutes on the loaded 2-core machine)
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${1:-/tmp/pyharm-venv/bin/python}
@@ -27,7 +27,7 @@ for ds in 0.1 0.2; do
     $ONE "$PY" pyharm_chain.py --ds $ds --csv results/pyharm_chain_frf_ds$ds.csv > results/chain_one_core_ds$ds.txt
 done
 
-# 137 DOFs: a whole sweep takes hours, so time the first 10 continuation points, once, from the
+# 137 DOFs: a sweep at ds = 0.2 takes hours, so time the first 10 continuation points, once, from the
 # band's lower end (stuck) and from 200 Hz (slipping, near the peak).
 $ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 10 \
     > results/paper_one_core_from170.txt
@@ -35,3 +35,5 @@ $ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 10 --band 200 300 \
     --csv results/pyharm_paper_frf_from200.csv > results/paper_one_core_from200.txt
 $ONE "$PY" pyharm_paper.py --runs 1 --ds 0.2 --max-points 5 --band 200 300 --reductor NLdofs \
     --csv /tmp/pyharm_paper_condensed.csv > results/paper_one_core_from200_condensed.txt
+# One whole 137-DOF sweep at a coarse density (64 points, about 25 min).
+$ONE "$PY" pyharm_paper.py --runs 1 --ds 2.0 --csv results/pyharm_paper_frf_ds2.csv > results/paper_one_core_ds2.txt
