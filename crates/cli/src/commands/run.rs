@@ -7,8 +7,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
-use stickslip_io::output::{write_frf_csv, write_frf_npz, write_time_data};
-use stickslip_io::plot::plot_frfs;
+use stickslip_io::output::write_results;
 use stickslip_io::study::Study;
 
 #[derive(clap::Args)]
@@ -68,18 +67,14 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let elapsed = started.elapsed();
 
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
-    let frf = args.out.join("frf.csv");
-    write_frf_csv(&frf, &levels)?;
-    write_frf_npz(&args.out.join("frf.npz"), &levels)?;
-    let n_time = write_time_data(&args.out, &levels)?;
-    let plots = plot_frfs(&args.out, &levels, study.output_options.plot_format)?;
+    let files = write_results(&args.out, &levels, study.output_options.plot_format)?;
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
-        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {}, frf.npz, {n_time} time-data file(s), {} plot(s)",
+        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, plots, points/)",
         levels.len(),
         elapsed.as_secs_f64(),
-        frf.display(),
-        plots.len()
+        files.len(),
+        args.out.display()
     );
     let incomplete: Vec<String> = runs
         .iter()
