@@ -71,13 +71,50 @@ impl Matrix {
 
     /// Largest `|A_ij − A_ji|` relative to the largest `|A_ij|`: 0 for a symmetric matrix.
     pub fn asymmetry(&self) -> f64 {
-        let d = self.to_dense();
-        let mut max = 0.0f64;
-        let mut diff = 0.0f64;
-        for j in 0..d.ncols() {
-            for i in 0..d.nrows() {
-                max = max.max(d[(i, j)].abs());
-                diff = diff.max((d[(i, j)] - d[(j, i)]).abs());
+        let (mut max, mut diff) = (0.0f64, 0.0f64);
+        match self {
+            Matrix::Dense(d) => {
+                for j in 0..d.ncols() {
+                    for i in 0..d.nrows() {
+                        max = max.max(d[(i, j)].abs());
+                        diff = diff.max((d[(i, j)] - d[(j, i)]).abs());
+                    }
+                }
+            }
+            Matrix::Sparse(m) => {
+                // Compare with the transpose entry by entry, without a dense copy (FE sizes):
+                // both are sorted column by column, so A − Aᵀ's entries are found by merging.
+                let a = m.as_ref();
+                let t = a.transpose().to_col_major().expect("transpose of a valid CSC matrix");
+                let t = t.as_ref();
+                for j in 0..a.ncols() {
+                    let (ra, va) = (a.symbolic().row_idx_of_col_raw(j), a.val_of_col(j));
+                    let (rt, vt) = (t.symbolic().row_idx_of_col_raw(j), t.val_of_col(j));
+                    let (mut p, mut q) = (0, 0);
+                    while p < ra.len() || q < rt.len() {
+                        let (x, y) = match (ra.get(p), rt.get(q)) {
+                            (Some(&i), Some(&k)) if i == k => {
+                                p += 1;
+                                q += 1;
+                                (va[p - 1], vt[q - 1])
+                            }
+                            (Some(&i), Some(&k)) if i < k => {
+                                p += 1;
+                                (va[p - 1], 0.0)
+                            }
+                            (Some(_), None) => {
+                                p += 1;
+                                (va[p - 1], 0.0)
+                            }
+                            _ => {
+                                q += 1;
+                                (0.0, vt[q - 1])
+                            }
+                        };
+                        max = max.max(x.abs());
+                        diff = diff.max((x - y).abs());
+                    }
+                }
             }
         }
         if max == 0.0 {
@@ -105,5 +142,27 @@ impl From<Mat<f64>> for Matrix {
 impl From<SparseColMat<usize, f64>> for Matrix {
     fn from(m: SparseColMat<usize, f64>) -> Self {
         Matrix::Sparse(m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    fn sparse(entries: &[(usize, usize, f64)]) -> Matrix {
+        let t: Vec<_> = entries.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+        Matrix::Sparse(SparseColMat::try_new_from_triplets(4, 4, &t).unwrap())
+    }
+
+    #[test]
+    fn sparse_asymmetry_equals_the_dense_one() {
+        let sym = sparse(&[(0, 0, 4.0), (1, 0, -1.0), (0, 1, -1.0), (3, 2, 2.0), (2, 3, 2.0), (3, 3, 1.0)]);
+        assert_eq!(sym.asymmetry(), 0.0);
+        // One entry without its mirror, one mirrored with a different value.
+        let asym = sparse(&[(0, 0, 4.0), (1, 0, -1.0), (0, 1, -1.5), (3, 1, 0.5), (3, 3, 1.0)]);
+        let dense = Matrix::Dense(asym.to_dense());
+        assert_eq!(asym.asymmetry(), dense.asymmetry());
+        assert_eq!(asym.asymmetry(), 0.5 / 4.0);
     }
 }
