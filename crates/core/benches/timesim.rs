@@ -165,7 +165,13 @@ fn hbm_point(
     let mut iterations = (0, "");
     for _ in 0..REPEATS {
         let mut start = Instant::now();
-        let mut hbm = CondensedHbm::new(model, load, HbmSettings { harmonics: 7, samples: 300 }).ok()?;
+        let mut hbm = match CondensedHbm::new(model, load, HbmSettings { harmonics: 7, samples: 300 }) {
+            Ok(h) => h,
+            Err(e) => {
+                println!("  HBM set-up: {e}");
+                return None;
+            }
+        };
         let x0 = hbm.linear_solution(TWO_PI * f, 1.0);
         let (it, from) = match hbm.solve(TWO_PI * f, 1.0, &x0, 1e-10, 100) {
             Ok((_, it)) => (it, "the stuck solution"),
@@ -182,7 +188,13 @@ fn hbm_point(
                         x0[k * q + a] = *v;
                     }
                 }
-                (hbm.solve(TWO_PI * f, 1.0, &x0, 1e-10, 100).ok()?.1, "the time solution")
+                match hbm.solve(TWO_PI * f, 1.0, &x0, 1e-10, 100) {
+                    Ok((_, it)) => (it, "the time solution"),
+                    Err(e) => {
+                        println!("  HBM from the time solution: {e}");
+                        return None;
+                    }
+                }
             }
         };
         times.push(start.elapsed());
