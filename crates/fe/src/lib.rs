@@ -4,7 +4,7 @@
 //! eigensolver ([`eigen`]) and the reductions ([`reduction`]: Craig-Bampton, the paper's
 //! free-mode variant Eqs. 3-5, slipped-joint enrichment).
 pub mod assembly;
+pub mod eigen;
 pub mod element;
 pub mod mesh;
-pub mod eigen;
 pub mod reduction;

@@ -3,6 +3,6 @@ pub mod analysis;
 pub mod matrix;
 pub mod output;
 pub mod plot;
-pub mod study;
 pub mod records;
+pub mod study;
 pub mod uff;

@@ -290,23 +290,11 @@ impl ElementAft {
     /// sample.
     fn slider_jacobian(&mut self, plan: &AftPlan, k: f64, k_r: f64, j0: usize, mut jac: MatMut<'_, f64>) {
         let (nc, nt) = (self.nc, self.nt);
-        let nh = nc / 2;
-        let dtheta = 2.0 * std::f64::consts::PI / nt as f64;
-        // Fourier sums of w_j = k s_j − k_r up to harmonic 2N.
-        self.weight_cos.iter_mut().for_each(|v| *v = 0.0);
-        self.weight_sin.iter_mut().for_each(|v| *v = 0.0);
+        // Fourier sums of w_j = k s_j − k_r up to harmonic 2N (one planned FFT).
         for j in 0..nt {
-            let w = if self.slipping[j] { -k_r } else { k - k_r };
-            if w == 0.0 {
-                continue;
-            }
-            let th = j as f64 * dtheta;
-            for m in 0..=2 * nh {
-                let (sm, cm) = (m as f64 * th).sin_cos();
-                self.weight_cos[m] += w * cm;
-                self.weight_sin[m] += w * sm;
-            }
+            self.time_buf[j] = if self.slipping[j] { -k_r } else { k - k_r };
         }
+        plan.fourier_sums(&self.time_buf, &mut self.weight_cos, &mut self.weight_sin, &mut self.scratch);
         // Σ_j w_j basis_c basis_c' from products of cos/sin (harmonics a of c, b of c').
         let wc = |m: isize| self.weight_cos[m.unsigned_abs()];
         let ws = |m: isize| m.signum() as f64 * self.weight_sin[m.unsigned_abs()];

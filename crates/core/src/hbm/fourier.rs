@@ -216,6 +216,38 @@ impl AftPlan {
     }
 }
 
+impl AftPlan {
+    /// Fourier sums `Σ_j x_j cos mθ_j` and `Σ_j x_j sin mθ_j` for m = 0..=`max_harmonic` (no
+    /// normalisation), by the planned FFT when the harmonics fit below Nyquist (`2m ≤ n_t`),
+    /// directly otherwise.
+    pub fn fourier_sums(&self, samples: &[f64], cos_sums: &mut [f64], sin_sums: &mut [f64], scratch: &mut AftScratch) {
+        let max_harmonic = cos_sums.len() - 1;
+        if 2 * max_harmonic <= self.n_samples {
+            scratch.time.copy_from_slice(samples);
+            self.forward
+                .process_with_scratch(&mut scratch.time, &mut scratch.spectrum, &mut scratch.fft_scratch)
+                .expect("buffer sizes are fixed by the plan");
+            // X_m = Σ x_j e^{−imθ_j} = Σ x_j cos mθ_j − i Σ x_j sin mθ_j.
+            for m in 0..=max_harmonic {
+                cos_sums[m] = scratch.spectrum[m].re;
+                sin_sums[m] = -scratch.spectrum[m].im;
+            }
+        } else {
+            let dtheta = 2.0 * std::f64::consts::PI / self.n_samples as f64;
+            for m in 0..=max_harmonic {
+                let (mut c, mut s) = (0.0, 0.0);
+                for (j, x) in samples.iter().enumerate() {
+                    let (sm, cm) = (m as f64 * j as f64 * dtheta).sin_cos();
+                    c += x * cm;
+                    s += x * sm;
+                }
+                cos_sums[m] = c;
+                sin_sums[m] = s;
+            }
+        }
+    }
+}
+
 /// Basis function c at angle θ: 1, cos θ, sin θ, cos 2θ, ...
 #[inline]
 pub fn basis(c: usize, theta: f64) -> f64 {
@@ -312,6 +344,23 @@ mod tests {
         }
         let (a, phi) = amplitude_phase(&c, 3);
         assert!((a - 5.0).abs() < 1e-15 && (phi + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn fourier_sums_by_fft_and_directly_equal_the_definition() {
+        for &(nt, m) in &[(64, 14), (15, 14)] {
+            let plan = AftPlan::new(3, nt).unwrap();
+            let mut s = plan.scratch();
+            let x: Vec<f64> = (0..nt).map(|j| ((j * j) % 7) as f64 - 2.5).collect();
+            let (mut c, mut sn) = (vec![0.0; m + 1], vec![0.0; m + 1]);
+            plan.fourier_sums(&x, &mut c, &mut sn, &mut s);
+            for k in 0..=m {
+                let th = |j: usize| 2.0 * std::f64::consts::PI * (k * j) as f64 / nt as f64;
+                let ce: f64 = (0..nt).map(|j| x[j] * th(j).cos()).sum();
+                let se: f64 = (0..nt).map(|j| x[j] * th(j).sin()).sum();
+                assert!((c[k] - ce).abs() < 1e-11 && (sn[k] - se).abs() < 1e-11, "nt {nt} m {k}");
+            }
+        }
     }
 
     #[test]

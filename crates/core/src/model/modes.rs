@@ -64,7 +64,7 @@ impl LinearModel {
                 norm += kphi[(i, r)].powi(2);
             }
             let relative = (res / norm).sqrt();
-            if relative > 1e-8 {
+            if relative > 1e-6 {
                 return Err(ModelError::Invalid(format!(
                     "the dense eigensolution of (K, M) is inaccurate for mode {} ({:.4} Hz): residual {relative:.2e}; reduce the model or check its conditioning",
                     r + 1,
