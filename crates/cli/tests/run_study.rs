@@ -16,22 +16,28 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-#[test]
-fn the_1dof_example_writes_an_frf_table_covering_the_band_at_every_level() {
-    let out = scratch("1dof");
+/// Run a shipped example into a scratch folder; its FRF table as (header, rows), and the folder.
+fn run_example(name: &str) -> (Vec<String>, Vec<Vec<f64>>, PathBuf) {
+    let out = scratch(name);
     let status = stickslip()
         .args(["run", "--quiet", "--out"])
         .arg(&out)
-        .arg(repo().join("examples/jenkins-1dof/study.toml"))
+        .arg(repo().join(format!("examples/{name}/study.toml")))
         .status()
         .unwrap();
-    assert!(status.success());
+    assert!(status.success(), "{name}");
     let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();
     let mut lines = table.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    (header, rows, out)
+}
+
+#[test]
+fn the_1dof_example_writes_an_frf_table_covering_the_band_at_every_level() {
+    let (header, rows, out) = run_example("jenkins-1dof");
     assert_eq!(&header[..2], &["level_N", "frequency_Hz"]);
-    let accel = header.iter().position(|h| *h == "mass_accel_frf_m_s2_per_N").expect("acceleration FRF column");
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let accel = header.iter().position(|h| h == "mass_accel_frf_m_s2_per_N").expect("acceleration FRF column");
     for level in [100.0, 1000.0, 3000.0, 10000.0] {
         let f: Vec<f64> = rows.iter().filter(|r| r[0] == level).map(|r| r[1]).collect();
         assert!(f.len() > 20, "level {level}: {} points", f.len());
@@ -64,19 +70,8 @@ fn a_bad_study_is_refused_with_the_file_line_and_key() {
 
 #[test]
 fn the_blade_example_runs_from_the_mesh_and_softens_as_the_contact_slips() {
-    let out = scratch("blade");
-    let status = stickslip()
-        .args(["run", "--quiet", "--out"])
-        .arg(&out)
-        .arg(repo().join("examples/blade-joint/study.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();
-    let mut lines = table.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let tip = header.iter().position(|h| *h == "tip_disp_frf_m_per_N").expect("tip FRF column");
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let (header, rows, _) = run_example("blade-joint");
+    let tip = header.iter().position(|h| h == "tip_disp_frf_m_per_N").expect("tip FRF column");
     let peak = |level: f64| {
         rows.iter()
             .filter(|r| r[0] == level)
