@@ -216,7 +216,8 @@ impl ElementAft {
                     &self.v_now,
                     &mut self.state,
                     &mut self.g_now,
-                    if want_jac { Some(&mut self.tangent) } else { None },
+                    // The closed-form slider Jacobian needs only the slip flags, not the tangent.
+                    if chain_rule { Some(&mut self.tangent) } else { None },
                 );
                 for a in 0..d {
                     self.g[a * nt + j] = self.g_now[a];
