@@ -1,7 +1,10 @@
 //! A study's frequency sweep at one force level, from the study's settings to result records:
 //! the harmonic balance with condensation (core `hbm`) continued across the band (core
 //! `continuation`), each converged point post-processed (core `post`) into an
-//! [`output::PointRecord`](crate::output::PointRecord).
+//! [`output::PointRecord`](crate::output::PointRecord); and the [`ReportData`] of a whole run
+//! ([`report_data`]).
+
+use std::path::PathBuf;
 
 use stickslip_core::continuation::{Branch, Observer, Options, Predictor, TerminationReason};
 use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings as CoreHbmSettings, SweepError};
@@ -9,7 +12,12 @@ use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
 
 use crate::output::{harmonics_from_coefficients, ElementRecord, LevelResult, OutputRecord, PointRecord};
-use crate::study::{self, Excitation, OutputSpec, Study};
+use crate::report::{
+    number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
+};
+use crate::study::{
+    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod, Study,
+};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
@@ -144,4 +152,126 @@ pub fn describe_termination(t: &TerminationReason) -> String {
             format!("the harmonic balance failed at {:.3} Hz: {error}", lambda / TWO_PI)
         }
     }
+}
+
+/// Largest model whose natural frequencies the report computes (dense eigensolution, O(n³)).
+pub const REPORT_MAX_EIGEN_DOFS: usize = 2000;
+/// Natural frequencies listed in the report.
+const REPORT_FREQUENCIES: usize = 12;
+
+/// What the report of a run shows: the study and its model described, the lowest natural
+/// frequencies of the analysed linear model (dense eigensolution, up to
+/// [`REPORT_MAX_EIGEN_DOFS`] DOFs), how each level ended, the FRF peaks, the files written
+/// (`files`, as returned by [`crate::output::write_results`]) and `timings` (`(stage, seconds)`).
+pub fn report_data(
+    study: &Study,
+    model: &NonlinearModel,
+    excitation: &Excitation,
+    runs: &[LevelRun],
+    files: &[PathBuf],
+    timings: Vec<(String, f64)>,
+) -> ReportData {
+    let levels: Vec<LevelResult> = runs.iter().map(|r| r.result.clone()).collect();
+    ReportData {
+        title: study.path.file_name().map_or_else(|| study.path.display().to_string(), |n| n.to_string_lossy().into()),
+        study_path: study.path.display().to_string(),
+        model: model_summary(study, model),
+        sweep: SweepSummary {
+            load: excitation.load.clone(),
+            levels_n: excitation.levels_n.clone(),
+            start_hz: study.sweep.start_hz,
+            end_hz: study.sweep.end_hz,
+            harmonics: study.hbm.harmonics,
+            samples: study.hbm.samples,
+        },
+        levels: runs
+            .iter()
+            .map(|r| LevelSummary {
+                level_n: r.result.level_n,
+                points: r.result.points.len(),
+                complete: r.is_complete(),
+                ending: describe_termination(&r.termination),
+            })
+            .collect(),
+        peaks: peaks(&levels),
+        files: files.to_vec(),
+        timings,
+    }
+}
+
+/// The model of a study in words, with the natural frequencies of its linear part.
+fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
+    let file =
+        |p: &std::path::Path| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into());
+    let source = match &study.model {
+        ModelSpec::Inline { .. } => "matrices in the study file".to_string(),
+        ModelSpec::Files { mass, stiffness, .. } => format!("matrix files {} and {}", file(mass), file(stiffness)),
+        ModelSpec::Mesh { path, .. } => format!("mesh {}", file(path)),
+    };
+    let reduction = study.reduction.as_ref().map(|r| {
+        let method = match r.method {
+            ReductionMethod::CraigBampton => "Craig-Bampton".to_string(),
+            ReductionMethod::FreeModes => "free modes (paper Eq. 5)".to_string(),
+            ReductionMethod::Enriched { release_modes } => {
+                format!("free modes enriched with {release_modes} modes of the released structure")
+            }
+        };
+        format!("{method}, {} modes, retained {}", r.modes, r.retain.join(", "))
+    });
+    let damping = match &study.damping {
+        DampingSpec::None => "none".to_string(),
+        DampingSpec::Rayleigh { alpha, beta } => {
+            format!("Rayleigh D = α M + β K, α = {} 1/s, β = {} s", number(*alpha), number(*beta))
+        }
+        DampingSpec::Modal { ratios } => {
+            let r: Vec<String> = ratios.iter().map(|z| number(*z)).collect();
+            format!("modal ratios ζ = {}", r.join(", "))
+        }
+        DampingSpec::Matrix(_) => "a damping matrix in the study file".to_string(),
+        DampingSpec::File(path) => format!("damping matrix file {}", file(path)),
+    };
+    let stiffness = |s: &JointStiffness| match s {
+        JointStiffness::Own(k) => format!("own stiffness {} N/m", number(*k)),
+        JointStiffness::Replaces(k) => format!("stiffness {} N/m, part of K, replaced (Eq. 11)", number(*k)),
+        JointStiffness::ReplacesComputed => "stiffness VᵀKV of the model, replaced (Eq. 11)".to_string(),
+    };
+    let joints = study
+        .joints
+        .iter()
+        .map(|j| {
+            let (law, parameters) = match &j.law {
+                LawSpec::Jenkins { threshold, stiffness: s } => {
+                    ("Jenkins", format!("threshold {} N, {}", number(*threshold), stiffness(s)))
+                }
+                LawSpec::Iwan { stiffness: s, slip_force, sliders } => {
+                    ("Iwan", format!("slip force {} N, {sliders} sliders, {}", number(*slip_force), stiffness(s)))
+                }
+                LawSpec::Coulomb { threshold, velocity_scale } => (
+                    "regularised Coulomb",
+                    format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
+                ),
+                LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
+            };
+            let placement = match &j.placement {
+                Placement::Dof(d) => format!("DOF {d} and the ground"),
+                Placement::Between(a, b) => format!("DOFs {a} and {b}"),
+                Placement::Vector(_) => "a vector over the DOFs".to_string(),
+            };
+            JointSummary { name: j.name.clone(), placement, law: law.to_string(), parameters }
+        })
+        .collect();
+    let n = model.linear.n_dofs();
+    let natural_frequencies = if n > REPORT_MAX_EIGEN_DOFS {
+        NaturalFrequencies::NotAvailable(format!(
+            "the model has {n} DOFs, more than the {REPORT_MAX_EIGEN_DOFS} of the dense eigensolution (see `stickslip modes`)"
+        ))
+    } else {
+        match model.linear.dense_modes() {
+            Ok(modes) => {
+                NaturalFrequencies::Computed(modes.frequencies_hz().into_iter().take(REPORT_FREQUENCIES).collect())
+            }
+            Err(e) => NaturalFrequencies::NotAvailable(format!("the eigensolution failed: {e}")),
+        }
+    };
+    ModelSummary { source, n_dofs: n, reduction, damping, joints, natural_frequencies }
 }

@@ -1,8 +1,9 @@
-//! stickslip-io: files in and out (study files, matrix formats, CSV/NPZ/UFF, plots).
+//! stickslip-io: files in and out (study files, matrix formats, CSV/NPZ/UFF, plots, the HTML report).
 pub mod analysis;
 pub mod matrix;
 pub mod output;
 pub mod plot;
 pub mod records;
+pub mod report;
 pub mod study;
 pub mod uff;

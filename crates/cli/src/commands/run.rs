@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
 use stickslip_io::output::write_results;
+use stickslip_io::report::write_report;
 use stickslip_io::study::Study;
 
 #[derive(clap::Args)]
@@ -23,6 +24,9 @@ pub struct Args {
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
+    /// Do not write the HTML report (report.html).
+    #[arg(long)]
+    pub no_report: bool,
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
@@ -76,6 +80,12 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         files.len(),
         args.out.display()
     );
+    if !args.no_report {
+        let timings = vec![("harmonic balance and continuation, all levels".to_string(), elapsed.as_secs_f64())];
+        let data = stickslip_io::analysis::report_data(&study, &model, &excitation, &runs, &files, timings);
+        let report = write_report(&args.out, &data).context("cannot write the report")?;
+        eprintln!("report: {}", report.display());
+    }
     let incomplete: Vec<String> = runs
         .iter()
         .filter(|r| !r.is_complete())
