@@ -10,6 +10,7 @@
 pub mod generate;
 pub mod gmsh;
 pub mod inp;
+pub mod structured;
 pub mod vtk;
 
 use std::collections::{BTreeMap, HashMap};
