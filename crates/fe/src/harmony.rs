@@ -158,7 +158,7 @@ impl Default for Design {
             diaphragm_thickness: 0.00431,
             blade_length: 0.118,
             blade_mass: 0.1086,
-            blade_thickness: 0.00857,
+            blade_thickness: 0.0088,
             screw_radii: [0.105, 0.135],
             screw_zone_radius: 0.010,
             contact_zone_half_height: 0.010,
@@ -252,10 +252,16 @@ impl Design {
             }
         };
         order(("hub_inner_radius", self.hub_inner_radius), ("hub_outer_radius", self.hub_outer_radius))?;
-        order(("hub_outer_radius", self.hub_outer_radius), ("envelope_ring_inner_radius", self.envelope_ring_inner_radius))?;
+        order(
+            ("hub_outer_radius", self.hub_outer_radius),
+            ("envelope_ring_inner_radius", self.envelope_ring_inner_radius),
+        )?;
         order(("hub_outer_radius", self.hub_outer_radius), ("body_top_radius", self.body_top_radius))?;
         order(("diaphragm_thickness", self.diaphragm_thickness), ("envelope_ring_height", self.envelope_ring_height))?;
-        order(("envelope_ring_inner_radius", self.envelope_ring_inner_radius), ("envelope_radius", self.envelope_radius))?;
+        order(
+            ("envelope_ring_inner_radius", self.envelope_ring_inner_radius),
+            ("envelope_radius", self.envelope_radius),
+        )?;
         let steel = self.steel_304l.density;
         let base_thickness = self.base_mass / (self.aluminium_2017a.density * PI * self.base_radius.powi(2));
         // Envelope: the bottom ring, then a wall of the thickness that gives the mass.
@@ -338,7 +344,15 @@ impl Design {
         let diaphragm_bottom = ring_top - self.diaphragm_thickness;
         let disk_top = diaphragm_bottom + self.body_height;
         let disk_bottom = disk_top - d.top_disk_thickness;
-        [base_top, ring_top, diaphragm_bottom, disk_bottom, disk_top, disk_top + self.blade_thickness, base_top + self.envelope_height]
+        [
+            base_top,
+            ring_top,
+            diaphragm_bottom,
+            disk_bottom,
+            disk_top,
+            disk_top + self.blade_thickness,
+            base_top + self.envelope_height,
+        ]
     }
 
     /// Number of DOFs of the mesh at this design's element size, estimated before meshing
@@ -352,7 +366,8 @@ impl Design {
         let axial = (z / h).ceil() + 8.0;
         let nodes_per_cell = if self.kind == SolidKind::Hex8 { 1.0 } else { 4.0 };
         // The revolved solid fills about half of its (r, z) bounding box.
-        Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors) as usize + 4 * 3 * self.blade_cells().iter().product::<usize>() * 4)
+        Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors) as usize
+            + 4 * 3 * self.blade_cells().iter().product::<usize>() * 4)
     }
 
     fn sectors(&self) -> usize {
@@ -383,11 +398,26 @@ impl Design {
         let mut profile = Vec::new();
         if with_envelope {
             profile.push(rect([0.0, self.base_radius], [0.0, base_top], "BASE_PLATE"));
-            profile.push(rect([self.envelope_ring_inner_radius, self.envelope_radius], [base_top, diaphragm_bottom], "ENVELOPE"));
-            profile.push(rect([self.envelope_ring_inner_radius, self.envelope_radius], [diaphragm_bottom, ring_top], "ENVELOPE"));
+            profile.push(rect(
+                [self.envelope_ring_inner_radius, self.envelope_radius],
+                [base_top, diaphragm_bottom],
+                "ENVELOPE",
+            ));
+            profile.push(rect(
+                [self.envelope_ring_inner_radius, self.envelope_radius],
+                [diaphragm_bottom, ring_top],
+                "ENVELOPE",
+            ));
             // The wall, cut at the blades' heights so that the contact zones have nodes there.
             let zc = 0.5 * (disk_top + blade_top);
-            let cuts = [ring_top, zc - self.contact_zone_half_height, disk_top, blade_top, zc + self.contact_zone_half_height, envelope_top];
+            let cuts = [
+                ring_top,
+                zc - self.contact_zone_half_height,
+                disk_top,
+                blade_top,
+                zc + self.contact_zone_half_height,
+                envelope_top,
+            ];
             for w in cuts.windows(2) {
                 if w[1] > w[0] + tol {
                     profile.push(rect([d.envelope_inner_radius, self.envelope_radius], [w[0], w[1]], "ENVELOPE"));
@@ -422,7 +452,11 @@ impl Design {
                 let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i];
                 let w = d.blade_width;
                 let origin = [root * c + 0.5 * w * s, root * s - 0.5 * w * c, disk_top];
-                let edges = [[self.blade_length * c, self.blade_length * s, 0.0], [-w * s, w * c, 0.0], [0.0, 0.0, self.blade_thickness]];
+                let edges = [
+                    [self.blade_length * c, self.blade_length * s, 0.0],
+                    [-w * s, w * c, 0.0],
+                    [0.0, 0.0, self.blade_thickness],
+                ];
                 let mut part = Part::new(&format!("BLADE_{}", i + 1), self.kind, tol)?;
                 part.add_block(&placed_box(origin, edges, self.blade_cells(), "BLADES"))?;
                 blades.push(part);
@@ -520,7 +554,8 @@ impl Design {
             for (i, part) in blades.iter().enumerate() {
                 let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i];
                 let idx = &blade_index[i];
-                let bottom: Vec<usize> = part.nodes_where(|x| (x[2] - disk_top).abs() < tol).iter().map(|&n| idx[n]).collect();
+                let bottom: Vec<usize> =
+                    part.nodes_where(|x| (x[2] - disk_top).abs() < tol).iter().map(|&n| idx[n]).collect();
                 let tip: Vec<usize> = part
                     .nodes_where(|x| (x[0] * c + x[1] * s - d.envelope_inner_radius).abs() < tol)
                     .iter()
@@ -528,18 +563,39 @@ impl Design {
                     .collect();
                 for (j, &r) in self.screw_radii.iter().enumerate() {
                     let centre = [r * c, r * s, disk_top];
-                    let b = add_ref(&mut mesh, blade_screws(i + 1)[j], centre, &format!("SCREW_{}_BLADE_{}", j + 1, i + 1))?;
-                    let a = add_ref(&mut mesh, body_screws(i + 1)[j], centre, &format!("SCREW_{}_BODY_{}", j + 1, i + 1))?;
+                    let b = add_ref(
+                        &mut mesh,
+                        blade_screws(i + 1)[j],
+                        centre,
+                        &format!("SCREW_{}_BLADE_{}", j + 1, i + 1),
+                    )?;
+                    let a =
+                        add_ref(&mut mesh, body_screws(i + 1)[j], centre, &format!("SCREW_{}_BODY_{}", j + 1, i + 1))?;
                     let on_blade = zone(&bottom, &mesh, centre, self.screw_zone_radius);
                     let on_body = zone(&top_face, &mesh, centre, self.screw_zone_radius);
-                    mesh.couplings.push(RigidCoupling { reference: b, nodes: on_blade, dofs: (1..=6).collect(), at: Default::default() });
-                    mesh.couplings.push(RigidCoupling { reference: a, nodes: on_body, dofs: (1..=6).collect(), at: Default::default() });
+                    mesh.couplings.push(RigidCoupling {
+                        reference: b,
+                        nodes: on_blade,
+                        dofs: (1..=6).collect(),
+                        at: Default::default(),
+                    });
+                    mesh.couplings.push(RigidCoupling {
+                        reference: a,
+                        nodes: on_body,
+                        dofs: (1..=6).collect(),
+                        at: Default::default(),
+                    });
                     connector(&mut mesh, a, b, [k; 6]);
                 }
                 let zc = 0.5 * (disk_top + blade_top);
                 let tip_point = [d.envelope_inner_radius * c, d.envelope_inner_radius * s, zc];
                 let t = add_ref(&mut mesh, top_blade(i + 1), tip_point, &format!("TOP_BLADE_{}", i + 1))?;
-                mesh.couplings.push(RigidCoupling { reference: t, nodes: tip, dofs: (1..=6).collect(), at: Default::default() });
+                mesh.couplings.push(RigidCoupling {
+                    reference: t,
+                    nodes: tip,
+                    dofs: (1..=6).collect(),
+                    at: Default::default(),
+                });
                 mesh.add_node_set("TOP_BLADES", [t]);
                 if with_envelope {
                     let wall: Vec<usize> = structure
@@ -554,7 +610,12 @@ impl Design {
                         .collect();
                     let cz = add_ref(&mut mesh, contact_zone(i + 1), tip_point, &format!("CONTACT_ZONE_{}", i + 1))?;
                     let nodes = zone(&wall, &mesh, tip_point, (0.5 * d.blade_width).max(self.contact_zone_half_height));
-                    mesh.couplings.push(RigidCoupling { reference: cz, nodes, dofs: (1..=6).collect(), at: Default::default() });
+                    mesh.couplings.push(RigidCoupling {
+                        reference: cz,
+                        nodes,
+                        dofs: (1..=6).collect(),
+                        at: Default::default(),
+                    });
                     // Contact: translations only (the tip may rotate on the wall); the vertical
                     // component is the one friction acts on (Section 3.1).
                     connector(&mut mesh, t, cz, [k, k, self.contact_vertical_stiffness, 0.0, 0.0, 0.0]);
@@ -577,10 +638,21 @@ impl Design {
                     x[2].abs() < tol && x[0].hypot(x[1]) <= self.shaker_zone_radius + tol
                 })
                 .collect();
-            mesh.couplings.push(RigidCoupling { reference: shaker, nodes: bottom, dofs: (1..=6).collect(), at: Default::default() });
+            mesh.couplings.push(RigidCoupling {
+                reference: shaker,
+                nodes: bottom,
+                dofs: (1..=6).collect(),
+                at: Default::default(),
+            });
             mesh.points.push(PointElement::Mass { id: point_id, node: shaker, mass: self.shaker_mass });
             point_id += 1;
-            mesh.points.push(PointElement::Spring { id: point_id, a: shaker, dir_a: 3, b: None, stiffness: self.shaker_spring });
+            mesh.points.push(PointElement::Spring {
+                id: point_id,
+                a: shaker,
+                dir_a: 3,
+                b: None,
+                stiffness: self.shaker_spring,
+            });
             for dir in [1, 2, 4, 5, 6] {
                 mesh.fixed.push((shaker, dir));
             }

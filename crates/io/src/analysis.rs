@@ -207,6 +207,11 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
         ModelSpec::Inline { .. } => "matrices in the study file".to_string(),
         ModelSpec::Files { mass, stiffness, .. } => format!("matrix files {} and {}", file(mass), file(stiffness)),
         ModelSpec::Mesh { path, .. } => format!("mesh {}", file(path)),
+        ModelSpec::Harmony { design, .. } => format!(
+            "generated Harmony-like assembly ({} elements, size {:.1} mm)",
+            design.kind.abaqus_name(),
+            design.element_size * 1e3
+        ),
     };
     let reduction = study.reduction.as_ref().map(|r| {
         let method = match r.method {

@@ -31,7 +31,13 @@ pub struct Args {
 
 pub fn main(args: Args) -> anyhow::Result<()> {
     let study = Study::load(&args.study)?;
-    let (model, excitation, outputs) = study.build_model()?;
+    let mut timings = Vec::new();
+    let (model, excitation, outputs) = study.build_model_timed(&mut timings)?;
+    if !args.quiet {
+        for (stage, secs) in &timings {
+            eprintln!("{stage}: {secs:.2} s");
+        }
+    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
 
@@ -44,11 +50,12 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .progress_chars("=> ");
     let (start_hz, end_hz) = (study.sweep.start_hz, study.sweep.end_hz);
     let started = Instant::now();
-    let runs: Vec<anyhow::Result<LevelRun>> = pool.install(|| {
+    let runs: Vec<anyhow::Result<(LevelRun, f64)>> = pool.install(|| {
         excitation
             .levels_n
             .par_iter()
             .map(|&level| {
+                let level_started = Instant::now();
                 let bar = bars.add(ProgressBar::new(1000));
                 bar.set_style(style.clone());
                 bar.set_prefix(format!("{level} N"));
@@ -58,20 +65,28 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 };
                 let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
                     .with_context(|| format!("level {level} N"))?;
+                let secs = level_started.elapsed().as_secs_f64();
                 bar.finish_with_message(format!(
-                    "{} points, {}",
+                    "{} points, {}, {secs:.2} s",
                     run.result.points.len(),
                     describe_termination(&run.termination)
                 ));
-                Ok(run)
+                Ok((run, secs))
             })
             .collect()
     });
-    let runs: Vec<LevelRun> = runs.into_iter().collect::<anyhow::Result<_>>()?;
+    let runs: Vec<(LevelRun, f64)> = runs.into_iter().collect::<anyhow::Result<_>>()?;
     let elapsed = started.elapsed();
+    for (run, secs) in &runs {
+        timings.push((format!("level {} N", run.result.level_n), *secs));
+    }
+    timings.push(("all levels (wall clock)".into(), elapsed.as_secs_f64()));
+    let runs: Vec<LevelRun> = runs.into_iter().map(|(run, _)| run).collect();
+    let written = Instant::now();
 
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
     let files = write_results(&args.out, &levels, study.output_options.plot_format)?;
+    timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
         "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, plots, points/)",
@@ -81,10 +96,15 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         args.out.display()
     );
     if !args.no_report {
-        let timings = vec![("harmonic balance and continuation, all levels".to_string(), elapsed.as_secs_f64())];
-        let data = stickslip_io::analysis::report_data(&study, &model, &excitation, &runs, &files, timings);
+        let data = stickslip_io::analysis::report_data(&study, &model, &excitation, &runs, &files, timings.clone());
         let report = write_report(&args.out, &data).context("cannot write the report")?;
         eprintln!("report: {}", report.display());
+    }
+    if !args.quiet {
+        eprintln!(
+            "total: {:.2} s",
+            timings.iter().filter(|(s, _)| !s.starts_with("level ")).map(|(_, t)| t).sum::<f64>()
+        );
     }
     let incomplete: Vec<String> = runs
         .iter()

@@ -41,9 +41,18 @@ impl Study {
     /// Read the matrix files (if any), check the model (sizes, symmetry, M positive definite by
     /// a Cholesky factorisation) and build the nonlinear model, the excitation and the outputs.
     pub fn build_model(&self) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
+        self.build_model_timed(&mut Vec::new())
+    }
+
+    /// As [`Study::build_model`], recording the time of each stage (name, seconds): mesh,
+    /// assembly, modes and reduction, as far as the study has them.
+    pub fn build_model_timed(
+        &self,
+        timings: &mut Vec<(String, f64)>,
+    ) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
         let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
-        let (full, model_at) = self.full_model()?;
+        let (full, model_at) = self.full_model(timings)?;
         // Reduction (Section 3.3): the nonlinear analysis runs on the reduced model; loads,
         // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
         // u = Vᵀ U = (Tᵀ V)ᵀ q).
@@ -52,7 +61,9 @@ impl Study {
             None => (full.into_linear(), None),
             Some(r) => {
                 let releases = self.releases(full.linear())?;
+                let started = std::time::Instant::now();
                 let red = reduce(&full, r, &releases).map_err(|k| err(r.at, k))?;
+                timings.push(("modes and reduction".into(), started.elapsed().as_secs_f64()));
                 (red.model.clone(), Some(red))
             }
         };
@@ -118,7 +129,7 @@ impl Study {
 
     /// The model as given (before any reduction), checked: M positive definite; inline and
     /// file models also for sizes and symmetry (assembled meshes are symmetric by construction).
-    fn full_model(&self) -> Result<(FullModel, ModelLocations), StudyError> {
+    fn full_model(&self, timings: &mut Vec<(String, f64)>) -> Result<(FullModel, ModelLocations), StudyError> {
         let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
         let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
         let damping = |at: Location| -> Result<Damping, StudyError> {
@@ -149,8 +160,24 @@ impl Study {
                 };
                 (m, k, labels, *at)
             }
+            ModelSpec::Harmony { design, at } => {
+                let started = std::time::Instant::now();
+                let mesh = design
+                    .build(stickslip_fe::harmony::Configuration::Assembly)
+                    .map_err(|source| err(at.section, StudyErrorKind::Invalid(format!("[model.harmony]: {source}"))))?;
+                timings.push(("mesh".into(), started.elapsed().as_secs_f64()));
+                let started = std::time::Instant::now();
+                let mut fe = FeModel::assemble(mesh).map_err(|source| {
+                    err(at.section, StudyErrorKind::Assembly { context: "[model.harmony]".into(), source })
+                })?;
+                timings.push(("assembly".into(), started.elapsed().as_secs_f64()));
+                fe.model.damping = damping(at.section)?;
+                return Ok((FullModel::Mesh(fe), *at));
+            }
             ModelSpec::Mesh { path, material, at } => {
+                let started = std::time::Instant::now();
                 let mut fe = read_mesh(path, material.as_ref()).map_err(|k| err(at.mass, k))?;
+                timings.push(("mesh reading and assembly".into(), started.elapsed().as_secs_f64()));
                 fe.model.damping = damping(at.section)?;
                 check_mass_positive_definite(&fe.model.mass).map_err(|e| err(at.mass, model_error(e)))?;
                 return Ok((FullModel::Mesh(fe), *at));

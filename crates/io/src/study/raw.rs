@@ -47,6 +47,26 @@ pub(crate) struct RawModel {
     pub dof_file: Option<S<String>>,
     pub mesh: Option<S<String>>,
     pub material: Option<S<RawMaterial>>,
+    pub harmony: Option<S<RawHarmony>>,
+}
+
+/// `[model.harmony]`: the generated Harmony-like assembly and the design values a study may
+/// change (the others keep the calibrated defaults of `stickslip_fe::harmony::Design`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawHarmony {
+    pub refinement: Option<S<f64>>,
+    pub element: Option<S<String>>,
+    pub diaphragm_thickness: Option<S<f64>>,
+    pub blade_thickness: Option<S<f64>>,
+    pub blade_length: Option<S<f64>>,
+    pub envelope_height: Option<S<f64>>,
+    pub base_radius: Option<S<f64>>,
+    pub shaker_mass: Option<S<f64>>,
+    pub shaker_spring: Option<S<f64>>,
+    pub shaker_zone_radius: Option<S<f64>>,
+    pub connector_stiffness: Option<S<f64>>,
+    pub screw_zone_radius: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]

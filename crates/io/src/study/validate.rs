@@ -79,7 +79,7 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     let n_inline = match &model {
         ModelSpec::Inline { dofs, .. } => Some(dofs.len()),
         ModelSpec::Files { dofs: DofNames::Inline(d), .. } => Some(d.len()),
-        ModelSpec::Files { .. } | ModelSpec::Mesh { .. } => None,
+        ModelSpec::Files { .. } | ModelSpec::Mesh { .. } | ModelSpec::Harmony { .. } => None,
     };
     let damping = damping(&src, raw.damping.as_ref(), file_damping, n_inline)?;
     let reduction = raw.reduction.as_ref().map(|r| reduction(&src, r)).transpose()?;
@@ -249,6 +249,67 @@ fn matrix(src: &Source, m: &S<RawMatrix>, n: usize, ctx: &str, key: &str) -> Res
     Ok(mat)
 }
 
+/// Largest generated model accepted (DOFs, estimated before meshing): about 8 GiB for the
+/// assembly, the factor of K − σM and the reduction at the paper's element density.
+const MAX_HARMONY_DOFS: usize = 1_000_000;
+
+/// `[model.harmony]`: the calibrated design with the values the study changes.
+fn harmony(src: &Source, h: &S<raw::RawHarmony>) -> Result<stickslip_fe::harmony::Design, StudyError> {
+    use stickslip_fe::element::SolidKind;
+    use stickslip_fe::harmony::Design;
+    const CTX: &str = "[model.harmony]";
+    let r = h.get_ref();
+    let refinement = match &r.refinement {
+        Some(v) => positive(src, v, CTX, "refinement", "")?,
+        None => 1.0,
+    };
+    let mut d = Design::refined(refinement);
+    if let Some(e) = &r.element {
+        d.kind = match e.get_ref().to_ascii_lowercase().as_str() {
+            "hex20" | "c3d20" => SolidKind::Hex20,
+            "hex8" | "c3d8" => SolidKind::Hex8,
+            other => {
+                return Err(
+                    src.invalid(&e.span(), format!("{CTX}: element must be \"hex20\" or \"hex8\", got {other:?}"))
+                )
+            }
+        };
+    }
+    let lengths: [(&str, &Option<S<f64>>, &mut f64, &str); 10] = [
+        ("diaphragm_thickness", &r.diaphragm_thickness, &mut d.diaphragm_thickness, " m"),
+        ("blade_thickness", &r.blade_thickness, &mut d.blade_thickness, " m"),
+        ("blade_length", &r.blade_length, &mut d.blade_length, " m"),
+        ("envelope_height", &r.envelope_height, &mut d.envelope_height, " m"),
+        ("base_radius", &r.base_radius, &mut d.base_radius, " m"),
+        ("shaker_mass", &r.shaker_mass, &mut d.shaker_mass, " kg"),
+        ("shaker_spring", &r.shaker_spring, &mut d.shaker_spring, " N/m"),
+        ("shaker_zone_radius", &r.shaker_zone_radius, &mut d.shaker_zone_radius, " m"),
+        ("connector_stiffness", &r.connector_stiffness, &mut d.connector_stiffness, " N/m"),
+        ("screw_zone_radius", &r.screw_zone_radius, &mut d.screw_zone_radius, " m"),
+    ];
+    for (key, given, slot, unit) in lengths {
+        if let Some(v) = given {
+            *slot = positive(src, v, CTX, key, unit)?;
+        }
+    }
+    if r.connector_stiffness.is_some() {
+        d.contact_vertical_stiffness = d.connector_stiffness;
+    }
+    // Geometry that cannot be built, and refinements out of reach, are refused here, before
+    // anything is meshed.
+    let estimate = d.estimated_dofs().map_err(|e| src.invalid(&h.span(), format!("{CTX}: {e}")))?;
+    if estimate > MAX_HARMONY_DOFS {
+        return Err(src.invalid(
+            &h.span(),
+            format!(
+                "{CTX}: refinement {refinement} would make about {estimate} DOFs (about {:.1} GiB to assemble, factorise and reduce); at most {MAX_HARMONY_DOFS} are accepted: lower `refinement`",
+                estimate as f64 * 8.0e3 / (1u64 << 30) as f64
+            ),
+        ));
+    }
+    Ok(d)
+}
+
 fn model(
     src: &Source,
     m: &S<raw::RawModel>,
@@ -260,13 +321,31 @@ fn model(
     let inline = r.mass.is_some() || r.stiffness.is_some();
     let files = r.mass_file.is_some() || r.stiffness_file.is_some();
     let damping_file = r.damping_file.as_ref().map(|p| resolve(p.get_ref()));
-    if [inline, files, r.mesh.is_some()].iter().filter(|x| **x).count() > 1 {
+    if [inline, files, r.mesh.is_some(), r.harmony.is_some()].iter().filter(|x| **x).count() > 1 {
         return Err(src.invalid(
             &m.span(),
             format!(
-                "{CTX}: give one model: inline `mass` and `stiffness`, `mass_file` and `stiffness_file`, or a `mesh`"
+                "{CTX}: give one model: inline `mass` and `stiffness`, `mass_file` and `stiffness_file`, a `mesh`, or `harmony`"
             ),
         ));
+    }
+    if let Some(h) = &r.harmony {
+        for (key, given) in [
+            ("dofs", r.dofs.is_some()),
+            ("dof_file", r.dof_file.is_some()),
+            ("damping_file", damping_file.is_some()),
+            ("material", r.material.is_some()),
+        ] {
+            if given {
+                return Err(src.invalid(
+                    &h.span(),
+                    format!("{CTX}: `{key}` does not go with `harmony` (the generated assembly has its own DOFs and materials)"),
+                ));
+            }
+        }
+        let here = src.location(&h.span());
+        let at = ModelLocations { section: at, mass: here, stiffness: here };
+        return Ok((ModelSpec::Harmony { design: harmony(src, h)?, at }, None));
     }
     if let Some(mat) = &r.material {
         if r.mesh.is_none() {
