@@ -52,11 +52,7 @@ fn main() {
             }
             eff.push(out);
         }
-        println!(
-            "\n{name}: {n} DOFs, solid mass {:.3} kg, {:.1} s",
-            fe.solid_mass,
-            t.elapsed().as_secs_f64()
-        );
+        println!("\n{name}: {n} DOFs, solid mass {:.3} kg, {:.1} s", fe.solid_mass, t.elapsed().as_secs_f64());
         // Axial character: vertical motion of the body top, the base centre and the envelope top
         // (mass-normalised shapes, so comparable between modes).
         let at = |name: &str| fe.model.dofs.iter().position(|l| l.name == name);

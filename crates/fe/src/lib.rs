@@ -5,7 +5,7 @@
 //! free-mode variant Eqs. 3-5, slipped-joint enrichment).
 pub mod assembly;
 pub mod eigen;
-pub mod harmony;
 pub mod element;
+pub mod harmony;
 pub mod mesh;
 pub mod reduction;

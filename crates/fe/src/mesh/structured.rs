@@ -338,7 +338,9 @@ fn rotate_quarter([x, y]: [f64; 2], q: usize) -> [f64; 2] {
 pub fn placed_box(origin: [f64; 3], edges: [[f64; 3]; 3], cells: [usize; 3], elset: &str) -> Block {
     Block {
         cells,
-        map: Box::new(move |[u, v, w]| [0, 1, 2].map(|d| origin[d] + u * edges[0][d] + v * edges[1][d] + w * edges[2][d])),
+        map: Box::new(move |[u, v, w]| {
+            [0, 1, 2].map(|d| origin[d] + u * edges[0][d] + v * edges[1][d] + w * edges[2][d])
+        }),
         elset: elset.into(),
     }
 }
@@ -367,7 +369,8 @@ mod tests {
         // Conformity: a face seen by one element only lies on the outer boundary of the
         // profile; a seam left unmerged (a crack) would show faces inside the body.
         let mut faces: HashMap<Vec<usize>, (usize, [f64; 3])> = HashMap::new();
-        const QUADS: [[usize; 4]; 6] = [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+        const QUADS: [[usize; 4]; 6] =
+            [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
         for (nodes, _) in &part.elements {
             for q in QUADS {
                 let mut key: Vec<usize> = q.iter().map(|&i| nodes[i]).collect();
@@ -379,7 +382,11 @@ mod tests {
         let on_boundary = |[x, y, z]: [f64; 3]| {
             let r = x.hypot(y);
             let near = |a: f64, b: f64| (a - b).abs() < 1e-3;
-            near(z, 0.0) || (near(z, 0.02) && r < 0.1) || (near(z, 0.05) && r > 0.1) || r > 0.145 || (r > 0.095 && r < 0.1 && z > 0.02)
+            near(z, 0.0)
+                || (near(z, 0.02) && r < 0.1)
+                || (near(z, 0.05) && r > 0.1)
+                || r > 0.145
+                || (r > 0.095 && r < 0.1 && z > 0.02)
         };
         let mut boundary = 0;
         for (count, c) in faces.values() {
