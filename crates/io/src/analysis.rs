@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use stickslip_core::continuation::{Branch, Observer, Options, Predictor, TerminationReason};
+use stickslip_core::continuation::{Branch, Observer, Options, Predictor, Rejection, TerminationReason};
 use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings as CoreHbmSettings, SweepError};
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
@@ -144,10 +144,18 @@ pub fn describe_termination(t: &TerminationReason) -> String {
             "no convergence at the first point, {:.3} Hz, after {iterations} Newton iterations (residual {residual_norm:.3e}): start the band where the response is closer to linear, or use more harmonics",
             lambda / TWO_PI
         ),
-        TerminationReason::StepTooSmall { lambda, residual_norm, attempts, iterations } => format!(
-            "stopped after {:.3} Hz: {attempts} ever smaller steps failed ({iterations} Newton iterations, last residual {residual_norm:.3e}); try a smaller [continuation] min_step_hz, more [harmonic_balance] samples or another predictor",
-            lambda / TWO_PI
-        ),
+        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, iterations } => {
+            let advice = match rejection {
+                Rejection::NewtonCycle => {
+                    "; with a stiff friction joint this is a time sample switching between stick and slip: try more [harmonic_balance] samples (e.g. 512)"
+                }
+                _ => "; try a smaller [continuation] min_step_hz, more [harmonic_balance] samples or another predictor",
+            };
+            format!(
+                "stopped after {:.3} Hz: {attempts} ever smaller steps failed ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}{advice}",
+                lambda / TWO_PI
+            )
+        }
         TerminationReason::ProblemError { lambda, error, .. } => {
             format!("the harmonic balance failed at {:.3} Hz: {error}", lambda / TWO_PI)
         }

@@ -271,6 +271,8 @@ pub enum TerminationReason {
     FirstPointFailed { lambda: f64, residual_norm: f64, iterations: usize },
     /// Every step down to `min_step` failed after the point at `lambda`.
     StepTooSmall {
+        /// Why the last (smallest) step was rejected.
+        rejection: Rejection,
         /// λ of the last converged point.
         lambda: f64,
         /// Residual norm at the end of the last failed correction.
@@ -301,10 +303,11 @@ impl std::fmt::Display for TerminationReason {
                 "no solution found at the start λ = {lambda}: Newton from the initial guess ended at residual \
                  {residual_norm:.3e} after {iterations} iterations"
             ),
-            TerminationReason::StepTooSmall { lambda, residual_norm, attempts, iterations } => write!(
+            TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, iterations } => write!(
                 f,
-                "no convergence after the point at λ = {lambda}: {attempts} steps tried, each half the previous \
-                 ({iterations} Newton iterations), down to the minimum step; last residual {residual_norm:.3e}"
+                "no step accepted after the point at λ = {lambda}: {attempts} steps tried, each half the previous \
+                 ({iterations} Newton iterations), down to the minimum step; the last was rejected because \
+                 {rejection} (residual {residual_norm:.3e})"
             ),
             TerminationReason::ProblemError { lambda, last_lambda, error } => match last_lambda {
                 Some(last) => {
@@ -313,6 +316,44 @@ impl std::fmt::Display for TerminationReason {
                 None => write!(f, "the problem failed at λ = {lambda}, before any point converged: {error}"),
             },
         }
+    }
+}
+
+/// Why a step was rejected (see ACCEPT-REJECT in the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rejection {
+    /// Newton did not reach the tolerance within `max_iterations`.
+    NoConvergence,
+    /// Newton alternated between the same iterates until `max_iterations`: the residual is
+    /// non-smooth there (e.g. a sample of a stiff friction joint switching between stick and
+    /// slip) and the corrector's hyperplane does not meet the branch near the prediction.
+    NewtonCycle,
+    /// A residual that is not finite, or a singular bordered matrix.
+    Singular,
+    /// The corrector travelled farther than the step (a jump to another part of the curve).
+    TravelledTooFar,
+    /// The secant turned by more than `max_angle` from the previous one.
+    TurnedTooSharply,
+    /// The first step went back past `λ_start`.
+    WentBack,
+    /// The solve at exactly the end of the interval did not converge.
+    EndSolveFailed,
+}
+
+impl std::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Rejection::NoConvergence => "Newton did not converge within the iteration limit",
+            Rejection::NewtonCycle => {
+                "Newton cycled between the same iterates (a non-smooth residual: the corrector's hyperplane \
+                 misses the branch near the prediction)"
+            }
+            Rejection::Singular => "the residual was not finite or the bordered matrix singular",
+            Rejection::TravelledTooFar => "the corrector travelled farther than the step",
+            Rejection::TurnedTooSharply => "the branch turned by more than the largest angle",
+            Rejection::WentBack => "the first step went back past the start of the interval",
+            Rejection::EndSolveFailed => "the solve at the end of the interval did not converge",
+        })
     }
 }
 

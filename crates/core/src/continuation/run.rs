@@ -3,7 +3,8 @@
 
 use super::linear::Workspace;
 use super::{
-    Branch, Calls, ContinuationError, Observer, Options, Point, Predictor, Problem, ProblemError, TerminationReason,
+    Branch, Calls, ContinuationError, Observer, Options, Point, Predictor, Problem, ProblemError, Rejection,
+    TerminationReason,
 };
 
 /// Follow the solution curve of `problem` from `λ_start` (solved from `x_guess`) to `λ_end`.
@@ -107,7 +108,7 @@ enum Constraint {
 
 enum Outcome {
     Converged { iterations: usize, residual_norm: f64 },
-    Failed { iterations: usize, residual_norm: f64 },
+    Failed { iterations: usize, residual_norm: f64, cause: Rejection },
     Problem { lambda: f64, error: ProblemError },
 }
 
@@ -123,6 +124,7 @@ impl StepControl {
     /// ADAPT STEP after a rejection: halve. Returns the termination when below `min_step`.
     fn reject(
         &mut self,
+        rejection: Rejection,
         iterations: usize,
         residual_norm: f64,
         last_lambda: f64,
@@ -133,6 +135,7 @@ impl StepControl {
         self.step *= 0.5;
         self.just_rejected = true;
         (self.step < options.min_step).then_some(TerminationReason::StepTooSmall {
+            rejection,
             lambda: last_lambda,
             residual_norm,
             attempts: self.attempts,
@@ -230,7 +233,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let (iterations, residual_norm) =
             match self.newton(Constraint::FixedLambda(self.lambda_start), options.first_point_max_iterations, true) {
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
-                Outcome::Failed { iterations, residual_norm } => {
+                Outcome::Failed { iterations, residual_norm, .. } => {
                     return TerminationReason::FirstPointFailed { lambda: self.lambda_start, residual_norm, iterations }
                 }
                 Outcome::Problem { lambda, error } => {
@@ -277,8 +280,8 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             // ACCEPT-REJECT
             let (iterations, residual_norm) = match outcome {
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
-                Outcome::Failed { iterations, residual_norm } => {
-                    match control.reject(iterations, residual_norm, last_lambda, options) {
+                Outcome::Failed { iterations, residual_norm, cause } => {
+                    match control.reject(cause, iterations, residual_norm, last_lambda, options) {
                         Some(termination) => return termination,
                         None => continue,
                     }
@@ -304,13 +307,19 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 options.corner_after < 64 && control.step < options.min_step * 2f64.powi(options.corner_after as i32);
             let corner = control.attempts >= options.corner_after || no_room;
             let travelled = distance(&self.z, &self.z_pred);
-            let mut acceptable = (travelled <= control.step || (corner && travelled <= 10.0 * control.step))
-                && (self.turn_angle() <= options.max_angle || corner)
-                && !(before_start && points.len() == 1);
+            let mut rejection = if !(travelled <= control.step || (corner && travelled <= 10.0 * control.step)) {
+                Some(Rejection::TravelledTooFar)
+            } else if !(self.turn_angle() <= options.max_angle || corner) {
+                Some(Rejection::TurnedTooSharply)
+            } else if before_start && points.len() == 1 {
+                Some(Rejection::WentBack)
+            } else {
+                None
+            };
 
             // TERMINATE at an interval end: solve again at exactly that λ from the guess
             // interpolated between the last point and the one beyond.
-            if acceptable && (beyond_end || before_start) {
+            if rejection.is_none() && (beyond_end || before_start) {
                 let boundary = if beyond_end { self.lambda_end } else { self.lambda_start };
                 let theta = (boundary - last_lambda) / (lambda_new - last_lambda);
                 for i in 0..n {
@@ -329,14 +338,14 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                             TerminationReason::ReturnedToStart
                         };
                     }
-                    Outcome::Failed { .. } => acceptable = false,
+                    Outcome::Failed { .. } => rejection = Some(Rejection::EndSolveFailed),
                     Outcome::Problem { lambda, error } => {
                         return TerminationReason::ProblemError { lambda, last_lambda: Some(last_lambda), error }
                     }
                 }
             }
-            if !acceptable {
-                match control.reject(iterations, residual_norm, last_lambda, options) {
+            if let Some(rejection) = rejection {
+                match control.reject(rejection, iterations, residual_norm, last_lambda, options) {
                     Some(termination) => return termination,
                     None => continue,
                 }
@@ -492,6 +501,8 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let mut iterations = 0;
         // Residual norms of the two previous iterates.
         let (mut older, mut old) = (f64::INFINITY, f64::INFINITY);
+        // The last four residual norms, newest last, to tell a cycle from a slow convergence.
+        let mut recent = [f64::NAN; 4];
         loop {
             let lambda = match constraint {
                 Constraint::Arclength => self.z[n] * self.scale.lambda,
@@ -512,13 +523,21 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 Err(error) => return Outcome::Problem { lambda, error },
             };
             if !residual_norm.is_finite() {
-                return Outcome::Failed { iterations, residual_norm };
+                return Outcome::Failed { iterations, residual_norm, cause: Rejection::Singular };
             }
             if residual_norm <= self.tolerance {
                 return Outcome::Converged { iterations, residual_norm };
             }
+            recent.rotate_left(1);
+            recent[3] = residual_norm;
             if iterations == max_iterations {
-                return Outcome::Failed { iterations, residual_norm };
+                let same = |a: f64, b: f64| (a - b).abs() <= 1e-3 * a.max(b);
+                let cause = if same(recent[3], recent[1]) && same(recent[2], recent[0]) {
+                    Rejection::NewtonCycle
+                } else {
+                    Rejection::NoConvergence
+                };
+                return Outcome::Failed { iterations, residual_norm, cause };
             }
             let sr = self.scale.residual;
             for (b, r) in self.ws.rhs.iter_mut().zip(&self.ws.residual) {
@@ -535,7 +554,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 Constraint::FixedLambda(_) => (self.ws.solve_fixed(self.scale.x, sr), n),
             };
             if !solved {
-                return Outcome::Failed { iterations, residual_norm };
+                return Outcome::Failed { iterations, residual_norm, cause: Rejection::Singular };
             }
             for (z, dz) in self.z[..size].iter_mut().zip(&self.ws.rhs) {
                 *z += dz;
