@@ -68,7 +68,7 @@ fn unsupported_volume(t: i32) -> Option<&'static str> {
 }
 
 /// Position of Abaqus node `i` in Gmsh's node list, per kind (mid-edge numbering differs).
-fn abaqus_order(kind: SolidKind) -> &'static [usize] {
+pub(crate) fn abaqus_order(kind: SolidKind) -> &'static [usize] {
     match kind {
         SolidKind::Tet4 => &[0, 1, 2, 3],
         // Gmsh: 8 on edge (2,3), 9 on edge (1,3); Abaqus the other way round.

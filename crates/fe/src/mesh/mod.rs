@@ -9,7 +9,9 @@
 
 pub mod generate;
 pub mod gmsh;
+pub mod gmsh_writer;
 pub mod inp;
+pub mod inp_writer;
 pub mod structured;
 pub mod vtk;
 
