@@ -24,8 +24,7 @@
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::gmsh::abaqus_order;
 use super::{Mesh, MeshError, Origin};
@@ -34,15 +33,7 @@ use crate::element::SolidKind;
 /// Write `mesh` as a Gmsh 4.1 ASCII file to `path` (nothing is written if the mesh cannot be
 /// expressed, e.g. a set name with a quote).
 pub fn write(mesh: &Mesh, path: impl AsRef<Path>) -> Result<(), MeshError> {
-    let path = path.as_ref();
-    let text = to_string(mesh)?;
-    std::fs::write(path, text).map_err(|source| MeshError::Io { file: path.to_path_buf(), source })
-}
-
-/// Write `mesh` as a Gmsh 4.1 ASCII file to `out`.
-pub fn write_to(mesh: &Mesh, out: &mut impl Write) -> Result<(), MeshError> {
-    let text = to_string(mesh)?;
-    out.write_all(text.as_bytes()).map_err(|source| MeshError::Io { file: PathBuf::from("(output stream)"), source })
+    super::write_text(path.as_ref(), &to_string(mesh)?)
 }
 
 /// Gmsh element type of a solid kind.

@@ -51,8 +51,7 @@
 
 use std::collections::{BTreeSet, HashSet};
 use std::fmt::Write as _;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::{Mesh, MeshError, Origin, PointElement};
 
@@ -68,15 +67,7 @@ const MAX_NAME: usize = 80;
 /// Write `mesh` as a deck to the file `path`. Nothing is written if the mesh cannot be
 /// expressed as a deck (a solid without material, a name that cannot be written, ...).
 pub fn write(mesh: &Mesh, path: impl AsRef<Path>) -> Result<(), MeshError> {
-    let path = path.as_ref();
-    let text = to_string(mesh)?;
-    std::fs::write(path, text).map_err(|source| MeshError::Io { file: path.to_path_buf(), source })
-}
-
-/// Write `mesh` as a deck to `out`.
-pub fn write_to(mesh: &Mesh, out: &mut impl Write) -> Result<(), MeshError> {
-    let text = to_string(mesh)?;
-    out.write_all(text.as_bytes()).map_err(|source| MeshError::Io { file: PathBuf::from("(output stream)"), source })
+    super::write_text(path.as_ref(), &to_string(mesh)?)
 }
 
 /// The deck for `mesh`.

@@ -42,6 +42,8 @@ impl std::fmt::Display for Origin {
 pub enum MeshError {
     #[error("cannot read {file}: {source}")]
     Io { file: PathBuf, source: std::io::Error },
+    #[error("cannot write {file}: {source}")]
+    Write { file: PathBuf, source: std::io::Error },
     #[error("{at}: {msg}")]
     Syntax { at: Origin, msg: String },
     #[error("{at}: unknown keyword *{keyword} (supported keywords are listed in docs/fe.md)")]
@@ -68,6 +70,12 @@ pub enum MeshError {
     NoSection { element: u64, kind: String },
     #[error("{at}: {what} element set {elset:?} has no property card (*MASS or *SPRING)")]
     NoProperty { at: Origin, what: String, elset: String },
+}
+
+/// Write the text of a mesh file (the writers build it whole first, so that nothing is written
+/// when the mesh cannot be expressed).
+fn write_text(path: &std::path::Path, text: &str) -> Result<(), MeshError> {
+    std::fs::write(path, text).map_err(|source| MeshError::Write { file: path.to_path_buf(), source })
 }
 
 /// Isotropic linear elastic material.
