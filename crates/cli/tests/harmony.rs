@@ -1,11 +1,7 @@
 //! The Harmony example end to end at the coarse refinement (element size 60 mm, ~31k DOFs,
 //! reduced to 103 DOFs + 34 free modes + 12 released modes): the paper's trends (Section 5.1-5.2).
-use std::path::PathBuf;
-use std::process::Command;
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod common;
+use common::{repo, scratch, stickslip};
 
 /// Column `name` of the FRF table.
 fn column(header: &[String], name: &str) -> usize {
@@ -14,8 +10,7 @@ fn column(header: &[String], name: &str) -> usize {
 
 #[test]
 fn harmony_softens_and_flattens_with_the_level_while_friction_dissipates() {
-    let dir = std::env::temp_dir().join(format!("stickslip-cli-harmony-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = scratch("harmony");
     std::fs::create_dir_all(&dir).unwrap();
     let study = std::fs::read_to_string(repo().join("examples/harmony/study.toml")).unwrap();
     let study = study
@@ -29,12 +24,7 @@ fn harmony_softens_and_flattens_with_the_level_while_friction_dissipates() {
     let path = dir.join("study.toml");
     std::fs::write(&path, study).unwrap();
     let out = dir.join("out");
-    let status = Command::new(env!("CARGO_BIN_EXE_stickslip"))
-        .args(["run", "--quiet", "--no-report", "--out"])
-        .arg(&out)
-        .arg(&path)
-        .status()
-        .unwrap();
+    let status = stickslip().args(["run", "--quiet", "--no-report", "--out"]).arg(&out).arg(&path).status().unwrap();
     assert!(status.success());
     let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();
     let mut lines = table.lines();

@@ -8,19 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn stickslip() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stickslip-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
+mod common;
+use common::{repo, scratch, stickslip};
 
 /// The browser to use: `chromium` (or `chromium-browser`) on the PATH.
 fn browser() -> Option<PathBuf> {

@@ -1,20 +1,8 @@
 //! `stickslip run` end to end on the shipped examples and on bad input.
 use std::path::PathBuf;
-use std::process::Command;
 
-fn stickslip() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stickslip-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
+mod common;
+use common::{repo, scratch, stickslip};
 
 /// Run a shipped example into a scratch folder; its FRF table as (header, rows), and the folder.
 fn run_example(name: &str) -> (Vec<String>, Vec<Vec<f64>>, PathBuf) {

@@ -465,7 +465,7 @@ impl Design {
 
         // Sensors on the revolved part: nearest nodes to the accelerometer positions.
         let mut sensor_nodes = Vec::new();
-        for (name, part, r_frac, angle, height) in ACCELEROMETERS {
+        for (k, (name, part, r_frac, angle, height)) in ACCELEROMETERS.into_iter().enumerate() {
             let present = match part {
                 Part3::Body => with_body,
                 _ => with_envelope,
@@ -487,7 +487,7 @@ impl Design {
             };
             let a = angle.to_radians();
             let n = revolved.nearest([radius * a.cos(), radius * a.sin(), z]);
-            sensor_nodes.push((name, n));
+            sensor_nodes.push((k, name, n));
         }
 
         // Mesh: reference nodes first, then the parts; sensors renumbered 101..
@@ -500,8 +500,8 @@ impl Design {
         ];
         let mut next_id = 1001u64;
         let structure_ids: Vec<u64> = (0..revolved.nodes.len())
-            .map(|n| match sensor_nodes.iter().position(|&(_, s)| s == n) {
-                Some(k) => accelerometer(ACCELEROMETERS.iter().position(|a| a.0 == sensor_nodes[k].0).unwrap()),
+            .map(|n| match sensor_nodes.iter().find(|&&(_, _, s)| s == n) {
+                Some(&(k, _, _)) => accelerometer(k),
                 None => {
                     next_id += 1;
                     next_id - 1
@@ -517,7 +517,7 @@ impl Design {
             blade_index.push(part.add_to(&mut mesh, &ids, next_element, &materials)?);
             next_element += part.elements.len() as u64;
         }
-        for (name, n) in &sensor_nodes {
+        for (_, name, n) in &sensor_nodes {
             mesh.add_node_set(&format!("ACC_{}", name.to_uppercase()), [structure[*n]]);
             mesh.add_node_set("ACCELEROMETERS", [structure[*n]]);
         }
