@@ -38,6 +38,8 @@ pub enum RecordsError {
     Mismatch { file: String, channel: String, what: String },
     #[error("no channel `{channel}` in {file}: available channels are {available:?}")]
     MissingChannel { file: String, channel: String, available: Vec<String> },
+    #[error("{0}")]
+    Invalid(String),
 }
 
 /// One sampled channel.
@@ -355,6 +357,22 @@ pub fn unit_label(unit: &str) -> String {
         return "NONE".into();
     }
     UNIT_LABELS.iter().find(|(u, _)| *u == unit).map_or_else(|| unit.to_string(), |(_, lab)| lab.to_string())
+}
+
+/// Add white Gaussian noise of standard deviation `rms` to `values`, drawn from a generator
+/// seeded with `seed`: the sensor noise of a virtual test, the same from run to run.
+pub fn add_white_noise(values: &mut [f64], rms: f64, seed: u64) -> Result<(), RecordsError> {
+    use rand::SeedableRng;
+    use rand_distr::Distribution;
+    if !(rms.is_finite() && rms >= 0.0) {
+        return Err(RecordsError::Invalid(format!("a noise level is a finite standard deviation >= 0, got {rms}")));
+    }
+    let normal = rand_distr::Normal::new(0.0, rms).map_err(|e| RecordsError::Invalid(e.to_string()))?;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    for v in values {
+        *v += normal.sample(&mut rng);
+    }
+    Ok(())
 }
 
 /// UFF datasets of time records (one time-response dataset per channel).

@@ -11,17 +11,28 @@
 //!   input and dissipated per cycle (viscous, each joint) and the harmonic amplitudes of each output;
 //! - `sweep_<level>N.csv`: the same channels plus `frequency_Hz`, every `--record-every` steps;
 //! - `sweep_<level>N_cycles.csv`: per excitation cycle, first-harmonic amplitude and phase of
-//!   each output against the excitation.
+//!   each output against the excitation;
+//! - with `--uff`, `sweep_<level>N.uff` instead of `sweep_<level>N.csv`: what the paper's
+//!   shaker test records (Section 2.4), the shaker's drive signal (V, proportional to the
+//!   force: the test piloted the tension, not the force) and the acceleration of every output
+//!   as UFF 58 time records, with white sensor noise (`--accel-noise`), ready for
+//!   `stickslip extract` and its force identification by Eq. 1.
+//!
+//! Reduced (dense) models are integrated in the coordinates of their modes (M = I,
+//! K = diag ω², D diagonal for Rayleigh or modal damping): the same Newmark solution to
+//! round-off of the eigensolution, at O(n q) per step instead of O(n²).
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context};
 use stickslip_core::model::NonlinearModel;
+use stickslip_core::model::{Damping, Modes};
 use stickslip_core::timesim::{
-    steady_state, swept_sine, Records, Scheme, SteadyState, SteadyStateOptions, SweepOptions,
+    steady_state, swept_sine, Records, Scheme, SlowBand, SteadyState, SteadyStateOptions, SweepOptions,
 };
-use stickslip_io::records::{write_table, write_time_csv, Channel, TimeRecords};
+use stickslip_io::records::{add_white_noise, time_records_to_uff, write_table, write_time_csv, Channel, TimeRecords};
 use stickslip_io::study::{OutputSpec, Study};
+use stickslip_io::uff;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -54,6 +65,40 @@ pub struct Args {
     /// For a sweep, write every k-th time step (the per-cycle harmonics use every step).
     #[arg(long, default_value_t = 10)]
     pub record_every: usize,
+    /// A band swept at --slow-rate instead (Hz, two values: LOW,HIGH), e.g. the friction range.
+    #[arg(long, value_delimiter = ',', requires = "slow_rate")]
+    pub slow_band: Option<Vec<f64>>,
+    /// Sweep rate inside --slow-band (Hz/s).
+    #[arg(long, requires = "slow_band")]
+    pub slow_rate: Option<f64>,
+    /// Coordinates of the integration: `modal` (dense models with Rayleigh, modal or no
+    /// damping: O(n q) per step), `physical`, or `auto` (modal where it applies).
+    #[arg(long, value_enum, default_value_t = Coordinates::Auto)]
+    pub coordinates: Coordinates,
+    /// Force levels (N, comma-separated) instead of the study's [excitation] levels.
+    #[arg(long, value_delimiter = ',')]
+    pub levels: Option<Vec<f64>>,
+    /// Sweep this band (Hz, START,END) instead of the study's [sweep] band, e.g. down to
+    /// 100 Hz where Eq. 1 identifies the force.
+    #[arg(long, value_delimiter = ',')]
+    pub band: Option<Vec<f64>>,
+    /// For a sweep, write what a shaker test records instead of the full time table: the
+    /// drive signal (V) and the accelerations of the outputs as UFF 58 (`sweep_<level>N.uff`).
+    #[arg(long)]
+    pub uff: bool,
+    /// White noise added to the UFF accelerations (m/s² RMS), the sensors' noise floor.
+    #[arg(long, default_value_t = 0.0, requires = "uff")]
+    pub accel_noise: f64,
+    /// Seed of the noise (the same seed gives the same records).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, clap::ValueEnum)]
+pub enum Coordinates {
+    Auto,
+    Modal,
+    Physical,
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
@@ -63,6 +108,20 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let scheme = if args.alpha == 0.0 { Scheme::AverageAcceleration } else { Scheme::Hht { alpha: args.alpha } };
     // Record only the DOFs the outputs combine.
     let dofs: Vec<usize> = (0..model.linear.n_dofs()).filter(|&i| outputs.iter().any(|o| o.vector[i] != 0.0)).collect();
+    let (model, modes) = in_coordinates(model, args.coordinates)?;
+    // The load pattern in the integration's coordinates (Φᵀ p in modal coordinates).
+    let pattern: Vec<f64> = match &modes {
+        Some(m) => (0..m.omega.len())
+            .map(|r| excitation.pattern.iter().enumerate().map(|(i, p)| m.shapes[(i, r)] * p).sum())
+            .collect(),
+        None => excitation.pattern.clone(),
+    };
+    let shapes = modes.map(|m| m.shapes);
+    let levels = match &args.levels {
+        Some(l) if l.iter().all(|x| x.is_finite() && *x > 0.0) => l.clone(),
+        Some(l) => bail!("--levels takes force amplitudes > 0 in N, got {l:?}"),
+        None => excitation.levels_n.clone(),
+    };
     let harmonics = args.harmonics.unwrap_or(study.hbm.harmonics);
     let started = Instant::now();
     let mut written = Vec::new();
@@ -70,8 +129,9 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         (Some(f), None) => {
             let mut summary = Vec::new();
             let mut columns = Vec::new();
-            for &level in &excitation.levels_n {
-                let mut o = SteadyStateOptions::new(f, excitation.pattern.iter().map(|p| p * level).collect());
+            for &level in &levels {
+                let mut o = SteadyStateOptions::new(f, pattern.iter().map(|p| p * level).collect());
+                o.mode_shapes = shapes.clone();
                 o.scheme = scheme;
                 o.steps_per_period = args.steps_per_period;
                 o.harmonics = harmonics;
@@ -80,9 +140,8 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 o.record_dofs = dofs.clone();
                 let s = steady_state(&model, &o).with_context(|| format!("level {level} N at {f} Hz"))?;
                 let path = args.out.join(format!("timesim_{level}N_{f}Hz.csv"));
-                let force: Vec<f64> =
-                    s.records.time.iter().map(|t| level * (2.0 * std::f64::consts::PI * f * t).cos()).collect();
-                write_records(&path, &outputs, &s.records, Some(force), None)?;
+                let force: Vec<f64> = s.records.excitation.iter().map(|e| level * e).collect();
+                write_time_csv(&path, &time_records(&path, &outputs, &s.records, Some(&force), None)?)?;
                 written.push(path);
                 let (cols, row) = summary_row(&model, &outputs, &s, level, harmonics)?;
                 columns = cols;
@@ -100,21 +159,41 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             written.push(path);
         }
         (None, Some(rate)) => {
-            for &level in &excitation.levels_n {
-                let (f0, f1) = (study.sweep.start_hz, study.sweep.end_hz);
-                let mut o = SweepOptions::new(f0, f1, rate, excitation.pattern.iter().map(|p| p * level).collect());
+            let (f0, f1) = match &args.band {
+                None => (study.sweep.start_hz, study.sweep.end_hz),
+                Some(b) if b.len() == 2 => (b[0], b[1]),
+                Some(b) => bail!("--band takes two frequencies START,END in Hz, got {b:?}"),
+            };
+            for &level in &levels {
+                let mut o = SweepOptions::new(f0, f1, rate, pattern.iter().map(|p| p * level).collect());
+                o.mode_shapes = shapes.clone();
+                if let (Some(band), Some(slow)) = (&args.slow_band, args.slow_rate) {
+                    if band.len() != 2 {
+                        bail!("--slow-band takes two frequencies LOW,HIGH in Hz, got {band:?}");
+                    }
+                    o.slow_band = Some(SlowBand { low_hz: band[0], high_hz: band[1], rate_hz_per_s: slow });
+                }
+                let schedule = o.schedule().context("the sweep")?;
+                if args.uff {
+                    // What a test system samples: low-passed below 0.4 of the sample rate.
+                    o.anti_alias_hz = Some(ANTI_ALIAS_FRACTION / (o.step().0 * args.record_every as f64));
+                }
                 o.scheme = scheme;
                 o.steps_per_period = args.steps_per_period;
                 o.record_dofs = dofs.clone();
                 o.record_every = args.record_every;
                 o.settle = Some((args.tolerance, args.max_periods));
+                let level_started = Instant::now();
                 let sweep = swept_sine(&model, &o).with_context(|| format!("level {level} N, sweep {f0}-{f1} Hz"))?;
-                let path = args.out.join(format!("sweep_{level}N.csv"));
-                let two_pi = 2.0 * std::f64::consts::PI;
-                let r = rate * (f1 - f0).signum();
-                let force: Vec<f64> =
-                    sweep.records.time.iter().map(|t| level * (two_pi * (f0 * t + 0.5 * r * t * t)).cos()).collect();
-                write_records(&path, &outputs, &sweep.records, Some(force), Some(sweep.frequency_hz.clone()))?;
+                let solve_s = level_started.elapsed().as_secs_f64();
+                let force: Vec<f64> = sweep.records.excitation.iter().map(|e| level * e).collect();
+                let path = args.out.join(format!("sweep_{level}N.{}", if args.uff { "uff" } else { "csv" }));
+                let records = time_records(&path, &outputs, &sweep.records, Some(&force), Some(&sweep.frequency_hz))?;
+                if args.uff {
+                    write_measured(&path, &records, args.accel_noise, args.seed)?;
+                } else {
+                    write_time_csv(&path, &records)?;
+                }
                 written.push(path);
                 // Per-cycle first harmonic of every output against the excitation phase.
                 let mut columns = vec!["frequency_Hz".to_string()];
@@ -142,7 +221,13 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 let path = args.out.join(format!("sweep_{level}N_cycles.csv"));
                 write_table(&path, &columns, &rows)?;
                 written.push(path);
-                eprintln!("{level} N: swept {f0}-{f1} Hz at {rate} Hz/s, {} cycles", sweep.cycles.len());
+                let steps = (schedule.duration() / sweep.step).ceil();
+                eprintln!(
+                    "{level} N: swept {f0}-{f1} Hz in {:.1} s of signal, {} cycles, {steps:.0} steps in {solve_s:.1} s ({:.2} µs per step)",
+                    schedule.duration(),
+                    sweep.cycles.len(),
+                    1e6 * solve_s / steps
+                );
             }
         }
         _ => bail!("give either --frequency HZ (steady state) or --sweep-rate HZ_PER_S (swept sine over the study's [sweep] band)"),
@@ -152,24 +237,75 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The model in the coordinates asked for, and its modes when they are modal.
+fn in_coordinates(model: NonlinearModel, asked: Coordinates) -> anyhow::Result<(NonlinearModel, Option<Modes>)> {
+    let dense = matches!(model.linear.mass, stickslip_core::model::Matrix::Dense(_));
+    let diagonal_damping = !matches!(model.linear.damping, Damping::Matrix(_));
+    match asked {
+        Coordinates::Physical => Ok((model, None)),
+        Coordinates::Auto if !(dense && diagonal_damping) => Ok((model, None)),
+        Coordinates::Auto | Coordinates::Modal => {
+            let modes = match model.linear.dense_modes() {
+                Ok(m) => m,
+                // A model with a rigid-body motion has no modal form; physical coordinates
+                // integrate it all the same.
+                Err(_) if asked == Coordinates::Auto => return Ok((model, None)),
+                Err(e) => return Err(e).context("--coordinates modal needs the modes of the model"),
+            };
+            let modal = model.into_modal(&modes)?;
+            Ok((modal, Some(modes)))
+        }
+    }
+}
+
+/// Cutoff of the anti-aliasing filter of `--uff` records as a fraction of their sample rate
+/// (with the 8th-order Butterworth of `stickslip_core::signal::antialias`, what would fold
+/// below 0.2 of the sample rate is attenuated by 46 dB or more).
+const ANTI_ALIAS_FRACTION: f64 = 0.4;
+
+/// Drive signal per newton of force: the paper's shaker gave 70 N for a 20 mV tension
+/// amplitude (Section 2.4). The shaker is modelled as a force source, so the drive is the
+/// force scaled; Eq. 1 recovers the force from the responses at 100 Hz.
+const DRIVE_V_PER_N: f64 = 0.020 / 70.0;
+
+/// What a shaker test records, as UFF 58: the drive signal and the accelerations of the
+/// outputs with white sensor noise.
+fn write_measured(path: &Path, records: &TimeRecords, accel_noise: f64, seed: u64) -> anyhow::Result<()> {
+    let mut measured = TimeRecords { channels: Vec::new(), ..records.clone() };
+    for (k, c) in records.channels.iter().enumerate() {
+        if c.name == "force" {
+            let values = c.values.iter().map(|f| f * DRIVE_V_PER_N).collect();
+            measured.channels.push(Channel { name: "drive".into(), unit: "V".into(), values });
+        } else if c.unit == "m_s2" {
+            let mut c = c.clone();
+            // One stream per channel: independent sensors.
+            add_white_noise(&mut c.values, accel_noise, seed.wrapping_mul(1000).wrapping_add(k as u64))
+                .with_context(|| format!("--accel-noise on channel {}", c.name))?;
+            measured.channels.push(c);
+        }
+    }
+    uff::write(path, &time_records_to_uff(&measured), uff::Encoding::Binary)?;
+    Ok(())
+}
+
 /// Time records of the outputs (displacement, velocity, acceleration), the force and the
-/// joints (restoring force and slider velocity, Eq. 33) as CSV.
-fn write_records(
+/// joints (restoring force and slider velocity, Eq. 33).
+fn time_records(
     path: &Path,
     outputs: &[OutputSpec],
     records: &Records,
-    force: Option<Vec<f64>>,
-    frequency: Option<Vec<f64>>,
-) -> anyhow::Result<()> {
+    force: Option<&[f64]>,
+    frequency: Option<&[f64]>,
+) -> anyhow::Result<TimeRecords> {
     if records.len() < 2 {
         bail!("fewer than 2 samples recorded for {}: lower --record-every", path.display());
     }
     let mut channels = Vec::new();
     if let Some(f) = frequency {
-        channels.push(Channel { name: "frequency".into(), unit: "Hz".into(), values: f });
+        channels.push(Channel { name: "frequency".into(), unit: "Hz".into(), values: f.to_vec() });
     }
     if let Some(f) = force {
-        channels.push(Channel { name: "force".into(), unit: "N".into(), values: f });
+        channels.push(Channel { name: "force".into(), unit: "N".into(), values: f.to_vec() });
     }
     for o in outputs {
         for (series, unit) in
@@ -195,14 +331,7 @@ fn write_records(
         });
     }
     let dt = records.time[1] - records.time[0];
-    let recs = TimeRecords {
-        source: path.display().to_string(),
-        start_s: records.time[0],
-        sample_rate_hz: 1.0 / dt,
-        channels,
-    };
-    write_time_csv(path, &recs)?;
-    Ok(())
+    Ok(TimeRecords { source: path.display().to_string(), start_s: records.time[0], sample_rate_hz: 1.0 / dt, channels })
 }
 
 /// One summary row: level, frequency, periods, periodicity, energies, harmonic amplitudes.

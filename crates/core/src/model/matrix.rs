@@ -32,6 +32,50 @@ impl Matrix {
         }
     }
 
+    /// The diagonal, if every entry off it is zero (modal coordinates); `None` otherwise.
+    pub fn diagonal_entries(&self) -> Option<Vec<f64>> {
+        let n = self.nrows();
+        if self.ncols() != n {
+            return None;
+        }
+        let mut d = vec![0.0; n];
+        match self {
+            Matrix::Dense(m) => {
+                for j in 0..n {
+                    for i in 0..n {
+                        if i == j {
+                            d[i] = m[(i, j)];
+                        } else if m[(i, j)] != 0.0 {
+                            return None;
+                        }
+                    }
+                }
+            }
+            Matrix::Sparse(m) => {
+                let m = m.as_ref();
+                for j in 0..n {
+                    for (&i, &v) in m.symbolic().row_idx_of_col_raw(j).iter().zip(m.val_of_col(j)) {
+                        if i == j {
+                            d[i] += v;
+                        } else if v != 0.0 {
+                            return None;
+                        }
+                    }
+                }
+            }
+        }
+        Some(d)
+    }
+
+    /// A sparse diagonal matrix.
+    pub fn from_diagonal(d: &[f64]) -> Self {
+        let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> =
+            d.iter().enumerate().map(|(i, &v)| faer::sparse::Triplet::new(i, i, v)).collect();
+        Matrix::Sparse(
+            SparseColMat::try_new_from_triplets(d.len(), d.len(), &triplets).expect("diagonal triplets are valid"),
+        )
+    }
+
     /// `y = A x`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         assert_eq!(x.len(), self.ncols(), "expected x of length {}, got {}", self.ncols(), x.len());

@@ -8,6 +8,8 @@
 //!   excitation level from an off-resonance response (Eq. 1).
 //! - [`peaks`]: resonance peaks of an FRF amplitude curve (frequency and amplitude).
 //! - [`shapes`]: DAC (Eq. 2) and MAC between shape vectors.
+//! - [`antialias`]: the anti-aliasing low-pass of a data acquisition system, for records
+//!   sampled from a simulation as a test system samples them.
 //! - [`period`]: one period of motion at many points from records synchronised on the excitation
 //!   phase, sampled at regular phase steps (the vibrometry "video" of Fig. 9).
 //!
@@ -15,6 +17,7 @@
 //! with θ = Ωt, and phases are measured from the reference's fundamental, taken as `cos θ` (the
 //! excitation `F cos Ωt` of Eq. 12), so measured and simulated harmonics compare directly.
 
+pub mod antialias;
 pub mod frf;
 pub mod harmonics;
 pub mod peaks;
@@ -59,4 +62,6 @@ pub enum SignalError {
     FrequencyOutOfRange { frequency_hz: f64, min_hz: f64, max_hz: f64 },
     #[error("the number of frames must be at least 1, got 0")]
     NoFrames,
+    #[error("{0}")]
+    Invalid(String),
 }

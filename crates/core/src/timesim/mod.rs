@@ -30,4 +30,4 @@ pub use error::TimesimError;
 pub use integrator::{EnergyTally, Integrator, Scheme, State};
 pub use records::{CycleEnergy, ElementRecords, Records};
 pub use steady::{steady_state, SteadyState, SteadyStateOptions};
-pub use sweep::{swept_sine, SweepCycle, SweepOptions, SweepRecord};
+pub use sweep::{swept_sine, SlowBand, SweepCycle, SweepOptions, SweepRecord, SweepSchedule};

@@ -1,5 +1,6 @@
 //! The linear operators of a step: `D x` and the solve with the effective matrix
-//! `S = M/(βh²) + (1+α)(γ/(βh) D + K)`, dense or sparse.
+//! `S = M/(βh²) + (1+α)(γ/(βh) D + K)`, dense, sparse or diagonal (a model in modal
+//! coordinates, [`crate::model::NonlinearModel::modal_form`], whose step then costs O(n q)).
 
 use std::collections::HashMap;
 
@@ -24,10 +25,14 @@ const SPARSE_ABOVE: usize = 400;
 pub(crate) enum Operator {
     Dense { n: usize, values: Vec<f64> },
     Sparse(Matrix),
+    Diagonal(Vec<f64>),
 }
 
 impl Operator {
     pub(crate) fn new(m: &Matrix) -> Self {
+        if let Some(d) = m.diagonal_entries() {
+            return Operator::Diagonal(d);
+        }
         match m {
             Matrix::Dense(d) => Operator::from_dense(d),
             Matrix::Sparse(_) => Operator::Sparse(m.clone()),
@@ -35,6 +40,9 @@ impl Operator {
     }
 
     pub(crate) fn from_dense(d: &Mat<f64>) -> Self {
+        if let Some(diagonal) = dense_diagonal(d) {
+            return Operator::Diagonal(diagonal);
+        }
         let n = d.nrows();
         let mut values = Vec::with_capacity(n * d.ncols());
         for j in 0..d.ncols() {
@@ -55,8 +63,14 @@ impl Operator {
                 }
             }
             Operator::Sparse(m) => m.mul_vec(x, y),
+            Operator::Diagonal(d) => y.iter_mut().zip(d).zip(x).for_each(|((y, d), x)| *y = d * x),
         }
     }
+}
+
+/// The diagonal of a square matrix with nothing off it.
+fn dense_diagonal(a: &Mat<f64>) -> Option<Vec<f64>> {
+    Matrix::Dense(a.clone()).diagonal_entries()
 }
 
 /// The linear part of the model as operators: `M x`, `K x`, `D x`.
@@ -122,7 +136,7 @@ impl DampingOperator {
     }
 
     fn is_sparse(&self) -> bool {
-        !matches!(self, DampingOperator::Matrix(Operator::Dense { .. }))
+        !matches!(self, DampingOperator::Matrix(Operator::Dense { .. } | Operator::Diagonal(_)))
     }
 
     /// Dense D.
@@ -132,6 +146,9 @@ impl DampingOperator {
             DampingOperator::None => Mat::zeros(n, n),
             DampingOperator::Matrix(Operator::Dense { values, .. }) => Mat::from_fn(n, n, |i, j| values[j * n + i]),
             DampingOperator::Matrix(Operator::Sparse(d)) => d.to_dense(),
+            DampingOperator::Matrix(Operator::Diagonal(d)) => {
+                Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 })
+            }
             DampingOperator::Rayleigh { alpha, beta } => {
                 let (m, k) = (model.mass.to_dense(), model.stiffness.to_dense());
                 Mat::from_fn(n, n, |i, j| alpha * m[(i, j)] + beta * k[(i, j)])
@@ -144,6 +161,8 @@ impl DampingOperator {
 pub(crate) enum SpdSolver {
     /// Explicit inverse (small models).
     DenseInverse(Mat<f64>),
+    /// Inverse of a diagonal matrix (models in modal coordinates).
+    Diagonal(Vec<f64>),
     /// Sparse Cholesky factor (AMD ordering) with its solve workspace allocated once, so that
     /// a solve does not allocate.
     Sparse { symbolic: Box<SymbolicCholesky<usize>>, values: Vec<f64>, workspace: MemBuffer },
@@ -153,6 +172,7 @@ impl std::fmt::Debug for SpdSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SpdSolver::DenseInverse(m) => write!(f, "SpdSolver::DenseInverse({}x{})", m.nrows(), m.ncols()),
+            SpdSolver::Diagonal(d) => write!(f, "SpdSolver::Diagonal({})", d.len()),
             SpdSolver::Sparse { values, .. } => write!(f, "SpdSolver::Sparse({} factor values)", values.len()),
         }
     }
@@ -172,6 +192,9 @@ impl SpdSolver {
                     }
                 }
             }
+            SpdSolver::Diagonal(inverse) => {
+                out.iter_mut().zip(inverse.iter()).zip(rhs).for_each(|((o, d), r)| *o = d * r);
+            }
             SpdSolver::Sparse { symbolic, values, workspace } => {
                 out.copy_from_slice(rhs);
                 let n = out.len();
@@ -188,6 +211,13 @@ impl SpdSolver {
     /// Factorise `Σ_i c_i A_i` (terms with zero coefficient are skipped); `None` if it is not
     /// positive definite.
     fn combination(n: usize, terms: &[(f64, &Matrix)], dense_extra: Option<(f64, &Mat<f64>)>) -> Option<Self> {
+        if let Some(d) = diagonal_combination(n, terms, dense_extra) {
+            // Positive definite iff every entry is positive.
+            return d
+                .iter()
+                .all(|&v| v > 0.0 && v.is_finite())
+                .then(|| SpdSolver::Diagonal(d.iter().map(|v| 1.0 / v).collect()));
+        }
         let all_sparse = n > SPARSE_ABOVE
             && dense_extra.is_none()
             && terms.iter().all(|(c, m)| *c == 0.0 || matches!(m, Matrix::Sparse(_)));
@@ -241,6 +271,20 @@ impl SpdSolver {
     }
 }
 
+/// `Σ_i c_i A_i` when every term is diagonal.
+fn diagonal_combination(n: usize, terms: &[(f64, &Matrix)], dense_extra: Option<(f64, &Mat<f64>)>) -> Option<Vec<f64>> {
+    let mut sum = vec![0.0; n];
+    let extra = dense_extra.map(|(c, d)| (c, Matrix::Dense(d.clone())));
+    for (c, m) in terms.iter().map(|&(c, m)| (c, m)).chain(extra.as_ref().map(|(c, m)| (*c, m))) {
+        if c == 0.0 {
+            continue;
+        }
+        let d = m.diagonal_entries()?;
+        sum.iter_mut().zip(&d).for_each(|(s, d)| *s += c * d);
+    }
+    Some(sum)
+}
+
 /// `S = c_m M + c_d D + c_k K` factorised.
 pub(crate) fn effective_solver(
     model: &LinearModel,
@@ -261,7 +305,9 @@ pub(crate) fn effective_solver(
                 ck += c_d * beta;
             }
             DampingOperator::Matrix(Operator::Sparse(d)) => terms.push((c_d, d)),
-            DampingOperator::Matrix(Operator::Dense { .. }) => unreachable!("dense damping takes the dense path"),
+            DampingOperator::Matrix(Operator::Dense { .. } | Operator::Diagonal(_)) => {
+                unreachable!("dense and diagonal damping take the dense path")
+            }
             DampingOperator::None => {}
         }
         terms.push((cm, &model.mass));

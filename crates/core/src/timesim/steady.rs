@@ -45,6 +45,10 @@ pub struct SteadyStateOptions {
     /// Start from this state (its displacement, velocity and element history, e.g. the final
     /// state at the previous frequency of a stepped sine) instead of rest.
     pub initial: Option<State>,
+    /// The mode shapes Φ when the model is in modal coordinates
+    /// ([`crate::model::NonlinearModel::into_modal`]): `record_dofs` are then DOFs of the
+    /// physical model, recorded as `Φ η`, and the load is in modal coordinates (`Φᵀ F`).
+    pub mode_shapes: Option<faer::Mat<f64>>,
 }
 
 impl SteadyStateOptions {
@@ -61,6 +65,7 @@ impl SteadyStateOptions {
             max_periods: 5000,
             record_dofs: Vec::new(),
             initial: None,
+            mode_shapes: None,
         }
     }
 }
@@ -130,6 +135,7 @@ pub fn steady_state(model: &NonlinearModel, options: &SteadyStateOptions) -> Res
         options.tolerance,
         options.max_periods,
         &options.record_dofs,
+        options.mode_shapes.as_ref(),
     )
 }
 
@@ -145,6 +151,7 @@ pub(crate) fn run_until_periodic(
     tolerance: f64,
     max_periods: usize,
     record_dofs: &[usize],
+    mode_shapes: Option<&faer::Mat<f64>>,
 ) -> Result<SteadyState, TimesimError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(TimesimError::Invalid(format!("the periodicity tolerance must be > 0, got {tolerance}")));
@@ -155,7 +162,7 @@ pub(crate) fn run_until_periodic(
     let omega = 2.0 * std::f64::consts::PI * frequency_hz;
     let step = integrator.step_size();
     let (alpha, _, _) = integrator.parameters();
-    let mut records = Records::new(model, record_dofs)?;
+    let mut records = Records::new(model, record_dofs, mode_shapes)?;
     let mut slider = vec![0.0; integrator.n_directions()];
     // Displacements one period back, overwritten as the period advances: a single n × P buffer.
     let mut previous = vec![0.0; n * p];
