@@ -24,7 +24,7 @@ enum Command {
     Modes(commands::modes::Args),
     /// Reduce a model (Craig-Bampton, free-mode variant, slipped-joint enrichment).
     Reduce(commands::reduce::Args),
-    /// Direct time integration of a study: steady state at one frequency or swept sine.
+    /// Direct time integration of a study: steady states at given frequencies, or a swept sine.
     Timesim(commands::timesim::Args),
     /// Harmonics and FRFs from time records (CSV or UFF 58).
     Extract(commands::extract::Args),

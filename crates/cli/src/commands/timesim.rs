@@ -1,4 +1,4 @@
-//! `stickslip timesim STUDY.toml --out DIR (--frequency HZ | --sweep-rate HZ_PER_S)`: direct time
+//! `stickslip timesim STUDY.toml --out DIR (--frequency HZ[,HZ...] | --sweep-rate HZ_PER_S)`: direct time
 //! integration of a study (paper Eq. 12) at every force level: the periodic steady state at one
 //! frequency, or a swept sine over the study's `[sweep]` band.
 //!
@@ -25,10 +25,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context};
+use rayon::prelude::*;
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::model::{Damping, Modes};
 use stickslip_core::timesim::{
-    steady_state, swept_sine, Records, Scheme, SlowBand, SteadyState, SteadyStateOptions, SweepOptions,
+    steady_state, swept_sine, Records, Scheme, SlowBand, SteadyState, SteadyStateOptions, SweepOptions, SweepRecord,
 };
 use stickslip_io::records::{add_white_noise, time_records_to_uff, write_table, write_time_csv, Channel, TimeRecords};
 use stickslip_io::study::{OutputSpec, Study};
@@ -41,9 +42,9 @@ pub struct Args {
     /// Output directory (created if needed).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Steady state at this excitation frequency (Hz).
-    #[arg(long, conflicts_with = "sweep_rate")]
-    pub frequency: Option<f64>,
+    /// Steady state at these excitation frequencies (Hz, comma-separated).
+    #[arg(long, value_delimiter = ',', conflicts_with = "sweep_rate")]
+    pub frequency: Option<Vec<f64>>,
     /// Swept sine over the study's [sweep] band at this rate (Hz/s), up or down as the band goes.
     #[arg(long)]
     pub sweep_rate: Option<f64>,
@@ -125,20 +126,33 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let harmonics = args.harmonics.unwrap_or(study.hbm.harmonics);
     let started = Instant::now();
     let mut written = Vec::new();
-    match (args.frequency, args.sweep_rate) {
-        (Some(f), None) => {
+    // Levels (and frequencies) are independent runs: solved in parallel on the thread pool,
+    // written in order.
+    match (&args.frequency, args.sweep_rate) {
+        (Some(frequencies), None) => {
+            if let Some(f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+                bail!("--frequency takes frequencies > 0 in Hz, got {f}");
+            }
+            let runs: Vec<(f64, f64)> =
+                levels.iter().flat_map(|&l| frequencies.iter().map(move |&f| (l, f))).collect();
+            let solved: Vec<anyhow::Result<SteadyState>> = runs
+                .par_iter()
+                .map(|&(level, f)| {
+                    let mut o = SteadyStateOptions::new(f, pattern.iter().map(|p| p * level).collect());
+                    o.mode_shapes = shapes.clone();
+                    o.scheme = scheme;
+                    o.steps_per_period = args.steps_per_period;
+                    o.harmonics = harmonics;
+                    o.tolerance = args.tolerance;
+                    o.max_periods = args.max_periods;
+                    o.record_dofs = dofs.clone();
+                    steady_state(&model, &o).with_context(|| format!("level {level} N at {f} Hz"))
+                })
+                .collect();
             let mut summary = Vec::new();
             let mut columns = Vec::new();
-            for &level in &levels {
-                let mut o = SteadyStateOptions::new(f, pattern.iter().map(|p| p * level).collect());
-                o.mode_shapes = shapes.clone();
-                o.scheme = scheme;
-                o.steps_per_period = args.steps_per_period;
-                o.harmonics = harmonics;
-                o.tolerance = args.tolerance;
-                o.max_periods = args.max_periods;
-                o.record_dofs = dofs.clone();
-                let s = steady_state(&model, &o).with_context(|| format!("level {level} N at {f} Hz"))?;
+            for (&(level, f), s) in runs.iter().zip(solved) {
+                let s = s?;
                 let path = args.out.join(format!("timesim_{level}N_{f}Hz.csv"));
                 let force: Vec<f64> = s.records.excitation.iter().map(|e| level * e).collect();
                 write_time_csv(&path, &time_records(&path, &outputs, &s.records, Some(&force), None)?)?;
@@ -164,28 +178,40 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 Some(b) if b.len() == 2 => (b[0], b[1]),
                 Some(b) => bail!("--band takes two frequencies START,END in Hz, got {b:?}"),
             };
-            for &level in &levels {
+            let slow_band = match (&args.slow_band, args.slow_rate) {
+                (Some(band), Some(slow)) if band.len() == 2 => {
+                    Some(SlowBand { low_hz: band[0], high_hz: band[1], rate_hz_per_s: slow })
+                }
+                (Some(band), _) => bail!("--slow-band takes two frequencies LOW,HIGH in Hz, got {band:?}"),
+                _ => None,
+            };
+            let options = |level: f64| {
                 let mut o = SweepOptions::new(f0, f1, rate, pattern.iter().map(|p| p * level).collect());
                 o.mode_shapes = shapes.clone();
-                if let (Some(band), Some(slow)) = (&args.slow_band, args.slow_rate) {
-                    if band.len() != 2 {
-                        bail!("--slow-band takes two frequencies LOW,HIGH in Hz, got {band:?}");
-                    }
-                    o.slow_band = Some(SlowBand { low_hz: band[0], high_hz: band[1], rate_hz_per_s: slow });
-                }
-                let schedule = o.schedule().context("the sweep")?;
-                if args.uff {
-                    // What a test system samples: low-passed below 0.4 of the sample rate.
-                    o.anti_alias_hz = Some(ANTI_ALIAS_FRACTION / (o.step().0 * args.record_every as f64));
-                }
+                o.slow_band = slow_band;
                 o.scheme = scheme;
                 o.steps_per_period = args.steps_per_period;
                 o.record_dofs = dofs.clone();
                 o.record_every = args.record_every;
                 o.settle = Some((args.tolerance, args.max_periods));
-                let level_started = Instant::now();
-                let sweep = swept_sine(&model, &o).with_context(|| format!("level {level} N, sweep {f0}-{f1} Hz"))?;
-                let solve_s = level_started.elapsed().as_secs_f64();
+                if args.uff {
+                    // What a test system samples: low-passed below 0.4 of the sample rate.
+                    o.anti_alias_hz = Some(ANTI_ALIAS_FRACTION / (o.step().0 * args.record_every as f64));
+                }
+                o
+            };
+            let schedule = options(1.0).schedule().context("the sweep")?;
+            let solved: Vec<anyhow::Result<(SweepRecord, f64)>> = levels
+                .par_iter()
+                .map(|&level| {
+                    let level_started = Instant::now();
+                    let sweep = swept_sine(&model, &options(level))
+                        .with_context(|| format!("level {level} N, sweep {f0}-{f1} Hz"))?;
+                    Ok((sweep, level_started.elapsed().as_secs_f64()))
+                })
+                .collect();
+            for (&level, result) in levels.iter().zip(solved) {
+                let (sweep, solve_s) = result?;
                 let force: Vec<f64> = sweep.records.excitation.iter().map(|e| level * e).collect();
                 let path = args.out.join(format!("sweep_{level}N.{}", if args.uff { "uff" } else { "csv" }));
                 let records = time_records(&path, &outputs, &sweep.records, Some(&force), Some(&sweep.frequency_hz))?;
@@ -195,31 +221,8 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                     write_time_csv(&path, &records)?;
                 }
                 written.push(path);
-                // Per-cycle first harmonic of every output against the excitation phase.
-                let mut columns = vec!["frequency_Hz".to_string()];
-                for o in &outputs {
-                    columns.push(format!("{}_amp_m", o.name));
-                    columns.push(format!("{}_phase_rad", o.name));
-                }
-                let rows: Vec<Vec<f64>> = sweep
-                    .cycles
-                    .iter()
-                    .map(|c| {
-                        let mut row = vec![c.frequency_hz];
-                        for o in &outputs {
-                            let (mut re, mut im) = (0.0, 0.0);
-                            for (k, &i) in dofs.iter().enumerate() {
-                                re += o.vector[i] * c.harmonic1[k].0;
-                                im -= o.vector[i] * c.harmonic1[k].1;
-                            }
-                            row.push(re.hypot(im));
-                            row.push(im.atan2(re));
-                        }
-                        row
-                    })
-                    .collect();
                 let path = args.out.join(format!("sweep_{level}N_cycles.csv"));
-                write_table(&path, &columns, &rows)?;
+                write_cycles(&path, &outputs, &dofs, &sweep)?;
                 written.push(path);
                 let steps = (schedule.duration() / sweep.step).ceil();
                 eprintln!(
@@ -230,10 +233,38 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 );
             }
         }
-        _ => bail!("give either --frequency HZ (steady state) or --sweep-rate HZ_PER_S (swept sine over the study's [sweep] band)"),
+        _ => bail!("give either --frequency HZ[,HZ...] (steady states) or --sweep-rate HZ_PER_S (swept sine over the study's [sweep] band)"),
     }
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     eprintln!("done in {:.2} s; wrote {}", started.elapsed().as_secs_f64(), names.join(", "));
+    Ok(())
+}
+
+/// Per excitation cycle, the first harmonic of every output against the excitation phase.
+fn write_cycles(path: &Path, outputs: &[OutputSpec], dofs: &[usize], sweep: &SweepRecord) -> anyhow::Result<()> {
+    let mut columns = vec!["frequency_Hz".to_string()];
+    for o in outputs {
+        columns.push(format!("{}_amp_m", o.name));
+        columns.push(format!("{}_phase_rad", o.name));
+    }
+    let rows: Vec<Vec<f64>> = sweep
+        .cycles
+        .iter()
+        .map(|c| {
+            let mut row = vec![c.frequency_hz];
+            for o in outputs {
+                let (mut re, mut im) = (0.0, 0.0);
+                for (k, &i) in dofs.iter().enumerate() {
+                    re += o.vector[i] * c.harmonic1[k].0;
+                    im -= o.vector[i] * c.harmonic1[k].1;
+                }
+                row.push(re.hypot(im));
+                row.push(im.atan2(re));
+            }
+            row
+        })
+        .collect();
+    write_table(path, &columns, &rows)?;
     Ok(())
 }
 
