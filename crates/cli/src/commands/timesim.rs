@@ -57,6 +57,13 @@ pub struct Args {
     /// Periodicity tolerance of the steady state (max |x(t+T) − x(t)| / max |x|, two periods in a row).
     #[arg(long, default_value_t = 1e-6)]
     pub tolerance: f64,
+    /// Judge the periodicity on the outputs' DOFs only, not on every DOF (stiff joints that
+    /// stick for less than a step: with --min-periods and a looser --tolerance, see docs/cli.md).
+    #[arg(long)]
+    pub periodic_on_outputs: bool,
+    /// Integrate at least this many periods before judging the periodicity.
+    #[arg(long, default_value_t = 0)]
+    pub min_periods: usize,
     /// Give up the steady state after this many periods.
     #[arg(long, default_value_t = 5000)]
     pub max_periods: usize,
@@ -146,6 +153,8 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                     o.tolerance = args.tolerance;
                     o.max_periods = args.max_periods;
                     o.record_dofs = dofs.clone();
+                    o.periodic_on_recorded = args.periodic_on_outputs;
+                    o.min_periods = args.min_periods;
                     steady_state(&model, &o).with_context(|| format!("level {level} N at {f} Hz"))
                 })
                 .collect();

@@ -201,8 +201,18 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
     let load = &options.load;
     let mut state = integrator.start(0.0, &vec![0.0; n], &vec![0.0; n], load, 1.0)?;
     if let Some((tolerance, max_periods)) = options.settle {
-        let steady =
-            run_until_periodic(&mut integrator, state, load, f0, steps_at_start, tolerance, max_periods, &[], None)?;
+        let steady = run_until_periodic(
+            &mut integrator,
+            state,
+            load,
+            f0,
+            steps_at_start,
+            tolerance,
+            max_periods,
+            &[],
+            None,
+            (false, 0),
+        )?;
         state = integrator.resume(&steady.final_state, load, 1.0)?;
     }
     let (alpha, _, _) = integrator.parameters();
