@@ -26,6 +26,12 @@ fn harmony_softens_and_flattens_with_the_level_while_friction_dissipates() {
     let out = dir.join("out");
     let status = stickslip().args(["run", "--quiet", "--no-report", "--out"]).arg(&out).arg(&path).status().unwrap();
     assert!(status.success());
+    // The generated mesh is written for CalculiX/Abaqus and Gmsh (round trips: fe's
+    // mesh_writers tests).
+    let deck = std::fs::read_to_string(out.join("model.inp")).unwrap();
+    assert!(deck.contains("*NODE") && deck.contains("*COUPLING") && deck.contains("*ELEMENT, TYPE=C3D20"));
+    let msh = std::fs::read_to_string(out.join("model.msh")).unwrap();
+    assert!(msh.starts_with("$MeshFormat\n4.1") && msh.contains("ACCELEROMETERS"));
     let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();
     let mut lines = table.lines();
     let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();

@@ -39,6 +39,16 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         }
     }
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    if let Some(mesh) = study.generated_mesh()? {
+        // A generated geometry is written for CalculiX/Abaqus and Gmsh users to open, check or
+        // reuse: the deck carries the couplings, connectors, shaker mass and spring.
+        let started = std::time::Instant::now();
+        stickslip_fe::mesh::inp_writer::write(&mesh, args.out.join("model.inp"))?;
+        stickslip_fe::mesh::gmsh_writer::write(&mesh, args.out.join("model.msh"))?;
+        if !args.quiet {
+            eprintln!("mesh files (model.inp, model.msh): {:.2} s", started.elapsed().as_secs_f64());
+        }
+    }
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
 
     let bars = MultiProgress::new();

@@ -44,6 +44,19 @@ impl Study {
         self.build_model_timed(&mut Vec::new())
     }
 
+    /// The mesh of a model that stickslip generates (`[model.harmony]`), for writing it as
+    /// `.inp` and `.msh`; `None` for models read from files or given inline.
+    pub fn generated_mesh(&self) -> Result<Option<stickslip_fe::mesh::Mesh>, StudyError> {
+        match &self.model {
+            ModelSpec::Harmony { design, at } => {
+                design.build(stickslip_fe::harmony::Configuration::Assembly).map(Some).map_err(|source| {
+                    self.error(Some(at.section), StudyErrorKind::Invalid(format!("[model.harmony]: {source}")))
+                })
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// As [`Study::build_model`], recording the time of each stage (name, seconds): mesh,
     /// assembly, modes and reduction, as far as the study has them.
     pub fn build_model_timed(
