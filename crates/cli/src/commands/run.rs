@@ -31,22 +31,23 @@ pub struct Args {
 
 pub fn main(args: Args) -> anyhow::Result<()> {
     let study = Study::load(&args.study)?;
-    let mut timings = Vec::new();
-    let (model, excitation, outputs) = study.build_model_timed(&mut timings)?;
-    if !args.quiet {
-        for (stage, secs) in &timings {
-            eprintln!("{stage}: {secs:.2} s");
-        }
-    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     if let Some(mesh) = study.generated_mesh()? {
         // A generated geometry is written for CalculiX/Abaqus and Gmsh users to open, check or
-        // reuse: the deck carries the couplings, connectors, shaker mass and spring.
+        // reuse (the deck carries the couplings, connectors, shaker mass and spring), before
+        // the solve, so that it is there even if the solve stops.
         let started = std::time::Instant::now();
         stickslip_fe::mesh::inp_writer::write(&mesh, args.out.join("model.inp"))?;
         stickslip_fe::mesh::gmsh_writer::write(&mesh, args.out.join("model.msh"))?;
         if !args.quiet {
             eprintln!("mesh files (model.inp, model.msh): {:.2} s", started.elapsed().as_secs_f64());
+        }
+    }
+    let mut timings = Vec::new();
+    let (model, excitation, outputs) = study.build_model_timed(&mut timings)?;
+    if !args.quiet {
+        for (stage, secs) in &timings {
+            eprintln!("{stage}: {secs:.2} s");
         }
     }
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
