@@ -194,3 +194,18 @@ fn several_loads_need_the_excitation_to_name_one() {
     let msg = parse_error(&text.replace("levels = [1.0, 2.0]", "load = \"shove\"\nlevels = [1.0, 2.0]"));
     assert!(msg.contains("no [[load]] named \"shove\" (loads are: push, pull)"), "{msg}");
 }
+
+#[test]
+fn harmonic_balance_sizes_are_bounded() {
+    // A mistyped size would otherwise allocate the AFT's arrays until the memory runs out.
+    let hbm = |key: &str| GOOD.to_string() + &format!("\n[harmonic_balance]\n{key}\n");
+    let msg = parse_error(&hbm("samples = 100000000"));
+    assert!(msg.contains("[harmonic_balance]: samples must be at most 16384, got 100000000"), "{msg}");
+    assert!(msg.starts_with("study.toml:29:11: "), "{msg}");
+    let msg = parse_error(&hbm("harmonics = 5000"));
+    assert!(msg.contains("harmonics must be at most 100, got 5000"), "{msg}");
+    let msg = parse_error(&hbm("max_iterations = 1000000000"));
+    assert!(msg.contains("max_iterations must be at most 10000"), "{msg}");
+    // The largest accepted sizes parse.
+    assert!(Study::parse(&hbm("harmonics = 100\nsamples = 16384"), "study.toml").is_ok());
+}

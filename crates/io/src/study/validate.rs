@@ -192,6 +192,23 @@ fn non_negative(src: &Source, v: &S<f64>, ctx: &str, key: &str, unit: &str) -> R
     Ok(x)
 }
 
+/// Bounds of the harmonic balance's sizes: memory and time per point grow with
+/// samples × directions × (2 harmonics + 1) (the AFT's derivative arrays), so 100 harmonics and
+/// 16384 samples (~100 MB per joint direction) are far beyond any friction study (the paper:
+/// 7 and 300) yet keep a mistyped value from exhausting the memory.
+const MAX_HARMONICS: i64 = 100;
+const MAX_SAMPLES: i64 = 16384;
+const MAX_ITERATIONS: i64 = 10_000;
+
+/// An integer in `min..=max`.
+fn count_at_most(src: &Source, v: &S<i64>, ctx: &str, key: &str, min: i64, max: i64) -> Result<usize, StudyError> {
+    let x = *v.get_ref();
+    if x > max {
+        return Err(src.invalid(&v.span(), format!("{ctx}: {key} must be at most {max}, got {x}")));
+    }
+    count(src, v, ctx, key, min)
+}
+
 fn count(src: &Source, v: &S<i64>, ctx: &str, key: &str, min: i64) -> Result<usize, StudyError> {
     let x = *v.get_ref();
     if x < min {
@@ -706,10 +723,10 @@ fn hbm(src: &Source, h: Option<&S<raw::RawHarmonicBalance>>) -> Result<HbmSettin
     let Some(h) = h else { return Ok(out) };
     let r = h.get_ref();
     if let Some(n) = &r.harmonics {
-        out.harmonics = count(src, n, CTX, "harmonics", 1)?;
+        out.harmonics = count_at_most(src, n, CTX, "harmonics", 1, MAX_HARMONICS)?;
     }
     if let Some(s) = &r.samples {
-        out.samples = count(src, s, CTX, "samples", 1)?;
+        out.samples = count_at_most(src, s, CTX, "samples", 1, MAX_SAMPLES)?;
     }
     let min = 2 * out.harmonics + 1;
     if out.samples < min {
@@ -723,7 +740,7 @@ fn hbm(src: &Source, h: Option<&S<raw::RawHarmonicBalance>>) -> Result<HbmSettin
         out.tolerance = positive(src, t, CTX, "tolerance", "")?;
     }
     if let Some(m) = &r.max_iterations {
-        out.max_iterations = count(src, m, CTX, "max_iterations", 1)?;
+        out.max_iterations = count_at_most(src, m, CTX, "max_iterations", 1, MAX_ITERATIONS)?;
     }
     Ok(out)
 }
