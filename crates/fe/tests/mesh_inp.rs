@@ -108,3 +108,13 @@ fn point_element_without_property_card_is_named() {
     let e = error_of(&format!("{NODES}*ELEMENT, TYPE=MASS, ELSET=SHAKER\n9, 1\n"));
     assert!(e.contains("bad.inp:7") && e.contains("element 9") && e.contains("\"SHAKER\""), "{e}");
 }
+
+#[test]
+fn data_lines_of_commas_only_are_refused_with_their_line() {
+    // Each block reads its fields by position; a line of separators has none (it used to
+    // index an empty field list and panic in *ELEMENT and *SURFACE).
+    for block in ["*ELEMENT, TYPE=C3D8, ELSET=E", "*SURFACE, NAME=S, TYPE=NODE", "*NSET, NSET=A", "*NODE"] {
+        let e = inp::parse(&format!("*NODE\n1, 0, 0, 0\n{block}\n , ,,\n"), "bad.inp").unwrap_err().to_string();
+        assert!(e.starts_with("bad.inp:4: ") && e.contains("only commas"), "{block}: {e}");
+    }
+}

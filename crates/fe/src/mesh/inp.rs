@@ -258,6 +258,12 @@ impl Parser {
         let (name, params) = keyword(&kw.text);
         // Most blocks ignore blank lines; *SPRING of SPRINGA needs its (possibly blank) first line.
         let nonblank: Vec<&Line> = data.iter().filter(|l| !l.text.is_empty()).collect();
+        // Every block reads its fields by position: a line of separators only has none.
+        if let Some(l) = nonblank.iter().find(|l| fields(&l.text).next().is_none()) {
+            return Err(
+                self.syntax(l, format!("a *{name} data line with no value (only commas): expected values or no line"))
+            );
+        }
         let param = |k: &str| params.get(k).map(|s| s.as_str());
         let required = |k: &str| {
             params.get(k).map(|s| s.as_str()).ok_or_else(|| self.syntax(kw, format!("*{name} needs {k}=...")))
