@@ -76,3 +76,15 @@ fn other_bad_input() {
     let s = SweepOptions::new(200.0, 260.0, 0.0, vec![F_EXCIT]);
     assert!(swept_sine(&model, &s).unwrap_err().to_string().contains("rate_hz_per_s"));
 }
+
+#[test]
+fn a_sweep_starting_far_below_its_end_is_refused_before_it_runs() {
+    let model = table6();
+    // 1e-320 Hz: the step and the start period overflow (it used to write time_s = inf, or
+    // to abort on a capacity overflow).
+    let err = swept_sine(&model, &SweepOptions::new(1e-320, 300.0, 10.0, vec![F_EXCIT])).unwrap_err();
+    assert!(err.to_string().contains("time steps"), "{err}");
+    // 1e-4 Hz: a start period of 3.8e8 steps, whose periodicity check would keep them all.
+    let err = swept_sine(&model, &SweepOptions::new(1e-4, 300.0, 10.0, vec![F_EXCIT])).unwrap_err();
+    assert!(err.to_string().contains("values to compare"), "{err}");
+}

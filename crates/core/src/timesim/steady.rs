@@ -32,6 +32,9 @@ use crate::model::NonlinearModel;
 /// error `(ωh)²/12` is then at most `(2π/10)²/12 ≈ 3.3 %` at that harmonic.
 pub(crate) const MIN_STEPS_PER_HARMONIC: usize = 10;
 
+/// Most values of one period kept by the periodicity check (2 GB of f64).
+const MAX_PERIOD_VALUES: f64 = 2.5e8;
+
 /// What to compute.
 #[derive(Clone, Debug)]
 pub struct SteadyStateOptions {
@@ -174,6 +177,15 @@ pub(crate) fn run_until_periodic(
 ) -> Result<SteadyState, TimesimError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(TimesimError::Invalid(format!("the periodicity tolerance must be > 0, got {tolerance}")));
+    }
+    // The check keeps one period of every DOF: bound it (a sweep starting far below its end
+    // frequency has a very long start period).
+    let kept = steps_per_period as f64 * integrator.model().linear.n_dofs() as f64;
+    if kept > MAX_PERIOD_VALUES {
+        return Err(TimesimError::Invalid(format!(
+            "one period of {steps_per_period} steps × {} DOFs is {kept:.3e} values to compare, more than {MAX_PERIOD_VALUES:.1e} (2 GB): use fewer steps per period, or start a sweep nearer its end frequency",
+            integrator.model().linear.n_dofs()
+        )));
     }
     if periodic_on_recorded && record_dofs.is_empty() {
         return Err(TimesimError::Invalid("periodicity judged on the recorded DOFs, but none is recorded".into()));

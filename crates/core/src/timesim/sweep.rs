@@ -9,6 +9,9 @@ use super::steady::{check_frequency, check_steps, run_until_periodic};
 use super::{EnergyTally, Integrator, Scheme, State, TimesimError};
 use crate::model::NonlinearModel;
 
+/// Most time steps a sweep may take (about an hour of one core for a reduced model).
+const MAX_STEPS: f64 = 1e9;
+
 /// What to compute.
 #[derive(Clone, Debug)]
 pub struct SweepOptions {
@@ -195,6 +198,17 @@ pub fn swept_sine(model: &NonlinearModel, options: &SweepOptions) -> Result<Swee
         return Err(TimesimError::Invalid("record_every must be at least 1".into()));
     }
     let f0 = options.start_hz;
+    // A start far below the end frequency makes the step tiny (a whole number of steps per
+    // start period, `steps_per_period` at the end) and the sweep endless: say so up front.
+    let per_start_period = options.steps_per_period as f64 * f0.max(options.end_hz) / f0;
+    let step = 1.0 / (f0 * per_start_period.ceil());
+    let total = schedule.duration() / step;
+    if !(per_start_period <= MAX_STEPS && step.is_finite() && step > 0.0 && total <= MAX_STEPS) {
+        return Err(TimesimError::Invalid(format!(
+            "a sweep from {f0} Hz to {} Hz at these rates would take {total:.3e} time steps of {step:.3e} s (at most {MAX_STEPS:.0e}): start nearer the end frequency, sweep faster or use fewer steps per period",
+            options.end_hz
+        )));
+    }
     let (step, steps_at_start) = options.step();
     let mut integrator = Integrator::new(model, options.scheme, step)?;
     let n = model.linear.n_dofs();
