@@ -1,6 +1,7 @@
 //! Sparse LDLᵀ factorisation of `K − σM`, the operator of shift-invert eigensolvers and of
-//! static condensation. The symbolic analysis (AMD ordering, elimination tree, supernodes) is
+//! static condensation. The symbolic analysis (ordering, elimination tree, supernodes) is
 //! done once per sparsity pattern and shared; new shifts only redo the numeric part.
+//! Fill-reducing ordering: METIS's nested dissection (minimum degree on small models).
 use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -18,6 +19,10 @@ use super::EigenError;
 /// Genuine pivots of FE matrices, even with connectors 1e6 times stiffer than the solid, stay
 /// above ~1e-8 of their diagonal; cancellation in a true singular pivot leaves ~1e-13.
 const SINGULAR_PIVOT_RATIO: f64 = 1e-10;
+
+/// Up to this order the minimum-degree ordering is analysed beside METIS's (its analysis costs
+/// 4.4 s at 306k DOFs, where it never wins on a 3-D mesh).
+const AMD_ALSO_BELOW: usize = 100_000;
 
 /// `K − σM = P L D Lᵀ Pᵀ` with the symbolic part reusable for another shift.
 pub struct ShiftedFactor {
@@ -38,23 +43,34 @@ impl ShiftedFactor {
         shift: f64,
     ) -> Result<Self, EigenError> {
         let a = shifted(stiffness, mass, shift)?;
-        // Both orderings are analysed (cheap next to the numeric factorisation) and the one
-        // with the smaller factor kept: minimum degree wins on small or thin models, nested
-        // dissection on large 3-D meshes.
+        // METIS's nested dissection leaves the smallest factor on 3-D meshes (Harmony at
+        // 306k DOFs: 220 M entries against 299 M for minimum degree, numeric factorisation
+        // 10 s against 34 s; BENCHMARKS.md). Minimum degree can win on small or thin models,
+        // where its analysis is cheap: both are analysed there and the smaller factor kept.
         let analyse = |ordering: SymmetricOrdering<'_, usize>| {
             factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ordering, CholeskySymbolicParams::default())
                 .map_err(|e| EigenError::Factorisation(format!("symbolic analysis failed: {e:?}")))
         };
-        let mut symbolic = analyse(SymmetricOrdering::Amd)?;
-        if a.nrows() > 2 * super::ordering::LEAF {
-            let fwd = super::ordering::nested_dissection(a.symbolic());
+        let metis = super::ordering::metis_nested_dissection(a.symbolic()).map(|fwd| {
             let inv = super::ordering::inverse(&fwd);
-            let perm = faer::perm::PermRef::new_checked(&fwd, &inv, a.nrows());
-            let nd = analyse(SymmetricOrdering::Custom(perm))?;
-            if nd.len_val() < symbolic.len_val() {
-                symbolic = nd;
+            (fwd, inv)
+        });
+        let symbolic = match &metis {
+            Some((fwd, inv)) => {
+                let nd = analyse(SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, a.nrows())))?;
+                if a.nrows() <= AMD_ALSO_BELOW {
+                    let amd = analyse(SymmetricOrdering::Amd)?;
+                    if amd.len_val() < nd.len_val() {
+                        amd
+                    } else {
+                        nd
+                    }
+                } else {
+                    nd
+                }
             }
-        }
+            None => analyse(SymmetricOrdering::Amd)?,
+        };
         let mut f = ShiftedFactor {
             symbolic: Arc::new(symbolic),
             values: Vec::new(),

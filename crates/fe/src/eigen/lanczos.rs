@@ -12,6 +12,7 @@ use faer::sparse::SparseColMat;
 use faer::{Accum, Mat, MatRef, Par, Side};
 use stickslip_core::model::Modes;
 
+use super::dense::symmetric_eigen;
 use super::{default_shift, EigenError, EigenOptions, EigenSolution, ShiftedFactor};
 
 /// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default).
@@ -118,29 +119,15 @@ pub fn modes_with_factor(
 
         // Rayleigh-Ritz on the projected operator (symmetric up to round-off).
         let s = Mat::<f64>::from_fn(ncv, ncv, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-        let evd = s
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|_| EigenError::Factorisation("the projected eigenproblem did not converge".into()))?;
+        let (theta, y) = symmetric_eigen(s.as_ref()).ok_or_else(projection_failed)?;
         // Largest |θ| first: the eigenvalues nearest the shift.
         let mut order: Vec<usize> = (0..ncv).collect();
-        order.sort_by(|&a, &b| evd.S()[b].abs().total_cmp(&evd.S()[a].abs()));
+        order.sort_by(|&a, &b| theta[b].abs().total_cmp(&theta[a].abs()));
         let beta_m = h[(ncv, ncv - 1)];
-        let residual = |i: usize| (beta_m * evd.U()[(ncv - 1, i)]).abs() / evd.S()[i].abs().max(f64::MIN_POSITIVE);
+        let residual = |i: usize| (beta_m * y[(ncv - 1, i)]).abs() / theta[i].abs().max(f64::MIN_POSITIVE);
         let converged = order[..nev].iter().filter(|&&i| residual(i) <= opts.tolerance).count();
         if converged == nev || ncv == n {
-            return finish(
-                k,
-                m,
-                v.as_ref(),
-                evd.U(),
-                &evd.S().column_vector().iter().copied().collect::<Vec<_>>(),
-                &order[..nev],
-                sigma,
-                factor,
-                solves,
-                restarts,
-                opts,
-            );
+            return finish(k, m, v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma, factor, solves, restarts, opts);
         }
         if restarts == opts.max_restarts {
             let worst = order[..nev].iter().map(|&i| residual(i)).fold(0.0, f64::max);
@@ -149,9 +136,9 @@ pub fn modes_with_factor(
         // Thick restart: keep the best Ritz vectors, the residual direction follows them.
         restarts += 1;
         let keep = (nev + (ncv - nev) / 2).min(ncv - 1);
-        let y = Mat::<f64>::from_fn(ncv, keep, |i, c| evd.U()[(i, order[c])]);
-        let new_v = v.subcols(0, ncv) * &y;
-        let new_mv = mv.subcols(0, ncv) * &y;
+        let y_keep = Mat::<f64>::from_fn(ncv, keep, |i, c| y[(i, order[c])]);
+        let new_v = v.subcols(0, ncv) * &y_keep;
+        let new_mv = mv.subcols(0, ncv) * &y_keep;
         let last = v.col(ncv).to_owned();
         let mlast = mv.col(ncv).to_owned();
         v.subcols_mut(0, keep).copy_from(&new_v);
@@ -161,8 +148,8 @@ pub fn modes_with_factor(
         h.fill(0.0);
         for c in 0..keep {
             let i = order[c];
-            h[(c, c)] = evd.S()[i];
-            h[(keep, c)] = beta_m * evd.U()[(ncv - 1, i)];
+            h[(c, c)] = theta[i];
+            h[(keep, c)] = beta_m * y[(ncv - 1, i)];
         }
         start = keep;
     }
@@ -289,8 +276,10 @@ fn refine(
     let mut a = a.transpose().to_owned();
     faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, a.as_mut(), Par::Seq);
     let a = Mat::from_fn(p, p, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-    let evd = a.self_adjoint_eigen(Side::Lower).map_err(|_| failed())?;
-    let mut q = evd.U().to_owned();
+    let (lambda, u) = symmetric_eigen(a.as_ref()).ok_or_else(failed)?;
+    let mut order: Vec<usize> = (0..p).collect();
+    order.sort_by(|&a, &b| lambda[a].total_cmp(&lambda[b]));
+    let mut q = Mat::<f64>::from_fn(p, p, |r, c| u[(r, order[c])]);
     faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), q.as_mut(), Par::Seq);
     *shapes = &x * &q;
     Ok(())
@@ -317,12 +306,14 @@ fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Ma
     }
 }
 
-/// Block shift-invert Lanczos without restart: blocks of `b` vectors, so that every solve
-/// with the factor serves `b` right-hand sides at once (a sparse triangular solve is bound by
-/// memory traffic through the factor: one block solve costs a few single ones), fully
-/// reorthogonalised in the M inner product. Ritz values of the projected operator, the
-/// residual estimate of each from the coupling with the next block. `None` when the
-/// subspace limit is reached before convergence (the caller falls back on thick restart).
+/// Block shift-invert Lanczos with thick restart (the block form of Wu & Simon's restart, as in
+/// block Krylov-Schur, Zhou & Saad, SIAM J. Matrix Anal. Appl. 29, 2008): blocks of `b`
+/// vectors, so that every solve with the factor serves `b` right-hand sides at once (a sparse
+/// triangular solve is bound by memory traffic through the factor: one block solve costs a few
+/// single ones), fully reorthogonalised in the M inner product. When the basis is full, the
+/// best Ritz vectors and the last block are kept and the recurrence goes on from them, so the
+/// block solves carry the whole iteration. `None` when the Krylov space closes before the
+/// wanted modes are in it (the caller falls back on single-vector thick restart).
 fn block_krylov(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
@@ -332,12 +323,17 @@ fn block_krylov(
     let n = k.nrows();
     let nev = opts.count;
     let b = nev.div_ceil(3).clamp(1, 16).min(n);
-    let max_dim = (4 * nev).max(nev + 40).min(n);
+    // Basis size before a restart: the wanted vectors and twice as many again (eight blocks
+    // at least) for the unwanted part of the spectrum that the restarts filter out; a block
+    // recurrence needs several blocks between restarts to filter (measured on a 25,830-DOF
+    // slab: with room for two blocks per cycle 100 modes did not converge in 200 restarts).
+    let max_dim = (3 * nev).max(nev + 8 * b).min(n);
     let par = Par::rayon(0);
     let mut v = Mat::<f64>::zeros(n, max_dim + b);
     let mut mv = Mat::<f64>::zeros(n, max_dim + b);
     let mut h = Mat::<f64>::zeros(max_dim + b, max_dim + b);
     let mut solves = 0;
+    let mut restarts = 0;
     // Start block: OP applied to pseudo-random vectors.
     let mut w = Mat::<f64>::from_fn(n, b, |i, j| pseudo_random(i + j * n));
     let mut mw = Mat::<f64>::zeros(n, b);
@@ -353,12 +349,7 @@ fn block_krylov(
         w = mv.subcols(start, nb).to_owned();
         factor.solve_in_place(w.as_mut());
         solves += nb;
-        let room = (max_dim + b - dim).min(nb);
-        let new_dim = if room > 0 {
-            append_block(m, &mut v, &mut mv, dim, w.subcols(0, nb).to_owned(), par).min(dim + room)
-        } else {
-            dim
-        };
+        let new_dim = append_block(m, &mut v, &mut mv, dim, w.clone(), par);
         // H[0..new_dim, block] = (M V)ᵀ W: the projection of OP on the basis.
         let coef = mv.subcols(0, new_dim).transpose() * &w;
         for c in 0..nb {
@@ -368,36 +359,59 @@ fn block_krylov(
         }
         // Rayleigh-Ritz on the first `dim` vectors.
         let s = Mat::<f64>::from_fn(dim, dim, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-        let evd = s
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|_| EigenError::Factorisation("the projected eigenproblem did not converge".into()))?;
-        let theta: Vec<f64> = (0..dim).map(|i| evd.S()[i]).collect();
+        let (theta, y) = symmetric_eigen(s.as_ref()).ok_or_else(projection_failed)?;
         let mut order: Vec<usize> = (0..dim).collect();
         order.sort_by(|&a, &b| theta[b].abs().total_cmp(&theta[a].abs()));
-        if dim >= nev {
-            // ‖OP x − θ x‖_M = ‖H[next block, last block] y_last‖.
-            let residual = |i: usize| {
-                let mut r2 = 0.0;
-                for row in dim..new_dim {
-                    let mut acc = 0.0;
-                    for c in start..dim {
-                        acc += h[(row, c)] * evd.U()[(c, i)];
-                    }
-                    r2 += acc * acc;
-                }
-                r2.sqrt() / theta[i].abs().max(f64::MIN_POSITIVE)
-            };
-            if order[..nev].iter().all(|&i| residual(i) <= opts.tolerance) {
-                let sigma = factor.shift();
-                return finish(k, m, v.as_ref(), evd.U(), &theta, &order[..nev], sigma, factor, solves, 0, opts)
-                    .map(Some);
-            }
+        // ‖OP x − θ x‖_M = ‖H[next block, last block] y_last‖: the kept Ritz vectors of a
+        // restart couple to the last block only, so this holds after restarts too.
+        let coupling = |i: usize| -> Vec<f64> {
+            (dim..new_dim).map(|row| (start..dim).map(|c| h[(row, c)] * y[(c, i)]).sum()).collect()
+        };
+        let residual =
+            |i: usize| coupling(i).iter().map(|x| x * x).sum::<f64>().sqrt() / theta[i].abs().max(f64::MIN_POSITIVE);
+        if dim >= nev && order[..nev].iter().all(|&i| residual(i) <= opts.tolerance) {
+            let sigma = factor.shift();
+            return finish(k, m, v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma, factor, solves, restarts, opts)
+                .map(Some);
         }
-        if new_dim == dim || new_dim > max_dim {
+        if new_dim == dim {
             return Ok(None);
         }
-        start = dim;
-        dim = new_dim;
+        let nb_new = new_dim - dim;
+        if new_dim + b <= v.ncols() {
+            start = dim;
+            dim = new_dim;
+            continue;
+        }
+        if restarts == opts.max_restarts {
+            let converged = order[..nev.min(dim)].iter().filter(|&&i| residual(i) <= opts.tolerance).count();
+            let worst = order[..nev.min(dim)].iter().map(|&i| residual(i)).fold(0.0, f64::max);
+            return Err(EigenError::NotConverged { restarts, converged, requested: nev, worst });
+        }
+        // Thick restart: the `keep` best Ritz vectors, then the new block, which is
+        // M-orthogonal to them; H becomes their Ritz values bordered by their coupling.
+        restarts += 1;
+        let keep = (nev + (max_dim - nev) / 3).min(dim).min(v.ncols() - nb_new - b);
+        let y = Mat::<f64>::from_fn(dim, keep, |r, c| y[(r, order[c])]);
+        let couplings: Vec<Vec<f64>> = (0..keep).map(|c| coupling(order[c])).collect();
+        let new_v = v.subcols(0, dim) * &y;
+        let new_mv = mv.subcols(0, dim) * &y;
+        let last = v.subcols(dim, nb_new).to_owned();
+        let mlast = mv.subcols(dim, nb_new).to_owned();
+        v.subcols_mut(0, keep).copy_from(&new_v);
+        mv.subcols_mut(0, keep).copy_from(&new_mv);
+        v.subcols_mut(keep, nb_new).copy_from(&last);
+        mv.subcols_mut(keep, nb_new).copy_from(&mlast);
+        h.fill(0.0);
+        for (c, coupling) in couplings.iter().enumerate() {
+            h[(c, c)] = theta[order[c]];
+            for (r, &x) in coupling.iter().enumerate() {
+                h[(keep + r, c)] = x;
+                h[(c, keep + r)] = x;
+            }
+        }
+        start = keep;
+        dim = keep + nb_new;
     }
     Ok(None)
 }
@@ -445,6 +459,10 @@ fn append_block(
     v.subcols_mut(dim, nb).copy_from(&w);
     mv.subcols_mut(dim, nb).copy_from(&mw);
     dim + nb
+}
+
+fn projection_failed() -> EigenError {
+    EigenError::Factorisation("the projected eigenproblem did not converge".into())
 }
 
 fn dot(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {

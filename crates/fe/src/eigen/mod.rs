@@ -5,9 +5,10 @@
 //! The shift σ lies below the lowest eigenvalue by default (a small negative value), so
 //! free-free structures, whose rigid-body modes sit at ω = 0, are solved as they are. Every
 //! returned mode's residual `‖Kφ − ω²Mφ‖ / ‖Kφ‖` is computed and returned.
+mod dense;
 mod factor;
 mod lanczos;
-mod ordering;
+pub mod ordering;
 
 pub use factor::ShiftedFactor;
 pub use lanczos::{modes_with_factor, solve};
