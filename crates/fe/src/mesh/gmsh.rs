@@ -177,11 +177,21 @@ impl Reader<'_> {
         })
     }
 
+    /// A Gmsh `int`: 32 bits in binary files, and held to that range in ASCII ones (a tag of
+    /// i64::MIN overflowed `abs`; a wider element type wrapped onto a supported one).
     fn int(&mut self, what: &str) -> Result<i64, MeshError> {
         if self.binary {
             Ok(i32::from_le_bytes(self.raw::<4>()?) as i64)
         } else {
-            self.ascii(what)
+            let start = self.mark();
+            let v: i64 = self.ascii(what)?;
+            if i32::try_from(v).is_err() {
+                return Err(MeshError::Syntax {
+                    at: self.origin(start),
+                    msg: format!("{what} {v} is not a 32-bit integer"),
+                });
+            }
+            Ok(v)
         }
     }
 
