@@ -236,7 +236,7 @@ fn uniform_rate(time: &[f64], lines: &[usize], file: &str) -> Result<f64, Record
         return Err(RecordsError::Header { file: file.into(), what: "a time record needs at least 2 samples".into() });
     }
     let dt = (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64;
-    if !(dt > 0.0 && dt.is_finite()) {
+    if !(dt > 0.0 && dt.is_finite() && (1.0 / dt).is_finite()) {
         return Err(RecordsError::Header { file: file.into(), what: "time must increase".into() });
     }
     for (j, (&t, &line)) in time.iter().zip(lines).enumerate() {
@@ -336,11 +336,14 @@ pub fn time_records_from_uff(datasets: &[Dataset58], file: &str) -> Result<TimeR
         };
         let (start, dt) = match &d.abscissa {
             Abscissa::Even { min, increment } => {
-                if !(increment.is_finite() && *increment > 0.0) {
+                // The rate 1/dt must be finite too (a subnormal increment gives an infinite one).
+                if !(increment.is_finite() && *increment > 0.0 && (1.0 / increment).is_finite()) {
                     return Err(RecordsError::Mismatch {
                         file: file.into(),
                         channel: name,
-                        what: format!("has a time increment of {increment} s, time must increase"),
+                        what: format!(
+                            "has a time increment of {increment} s: time must increase at a finite sample rate"
+                        ),
                     });
                 }
                 (*min, *increment)
@@ -613,7 +616,9 @@ pub fn frf_sets_from_uff(datasets: &[Dataset58], file: &str) -> Vec<FrfSet> {
                     .trim()
                     .strip_prefix("level ")
                     .and_then(|l| l.strip_suffix(" N"))
-                    .and_then(|l| l.parse().ok()),
+                    .and_then(|l| l.parse::<f64>().ok())
+                    // `level NaN N` is no level: left unknown, as an id2 without one.
+                    .filter(|l| l.is_finite()),
                 frequency_hz: d.x(),
                 curves: vec![FrfCurve {
                     name: d.ids[0].trim().replace([' ', ','], "_"),

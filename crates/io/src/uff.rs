@@ -578,6 +578,21 @@ fn parse_58(
     if even && found > 1 && x_inc <= 0.0 {
         return Err(ctx.malformed(l7, format!("abscissa increment {x_inc} of {found} points: it must be > 0")));
     }
+    if even && found > 1 {
+        // In f64 the points must still increase and stay finite (an increment below the
+        // resolution of the minimum, or a last point beyond 1.8e308, does not).
+        let x = |i: usize| x_min + i as f64 * x_inc;
+        if let Some(i) = (1..found).find(|&i| !(x(i).is_finite() && x(i) > x(i - 1))) {
+            return Err(ctx.malformed(
+                l7,
+                format!(
+                    "abscissa minimum {x_min} and increment {x_inc}: point {} is at {}, not above point {i}",
+                    i + 1,
+                    x(i)
+                ),
+            ));
+        }
+    }
     if !even {
         for p in 1..found {
             let (a, b) = (values[(p - 1) * per_point], values[p * per_point]);

@@ -177,8 +177,9 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
         } else {
             let t: Vec<_> =
                 p.entries.iter().map(|(_, r, c, v)| faer::sparse::Triplet::new(index(r), index(c), *v)).collect();
-            faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
-                .map_err(|e| MatrixFileError::invalid(path, format!("matrix {name}: {e:?}")))?
+            let m = faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
+                .map_err(|e| MatrixFileError::invalid(path, format!("matrix {name}: {e:?}")))?;
+            super::finite_sums(path, m)?
         };
         out.push(DmigMatrix { name, symmetric: p.symmetric, matrix: LabelledMatrix::nodal(keys, matrix) });
     }

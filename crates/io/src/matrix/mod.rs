@@ -108,9 +108,33 @@ impl SymmetricTriplets {
     }
 
     pub(crate) fn build(self, path: &Path, n: usize) -> Result<SparseColMat<usize, f64>, MatrixFileError> {
-        SparseColMat::try_new_from_triplets(n, n, &self.triplets)
-            .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))
+        let m = SparseColMat::try_new_from_triplets(n, n, &self.triplets)
+            .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))?;
+        finite_sums(path, m)
     }
+}
+
+/// Duplicate entries are summed: finite values can sum to infinity (1e308 + 1e308).
+pub(crate) fn finite_sums(
+    path: &Path,
+    m: SparseColMat<usize, f64>,
+) -> Result<SparseColMat<usize, f64>, MatrixFileError> {
+    let a = m.as_ref();
+    for j in 0..a.ncols() {
+        if let Some(p) = a.val_of_col(j).iter().position(|v| !v.is_finite()) {
+            let i = a.symbolic().row_idx_of_col_raw(j)[p];
+            return Err(MatrixFileError::invalid(
+                path,
+                format!(
+                    "the entries at row {}, column {} sum to {}, which is not finite",
+                    i + 1,
+                    j + 1,
+                    a.val_of_col(j)[p]
+                ),
+            ));
+        }
+    }
+    Ok(m)
 }
 
 /// Parse a Nastran/Fortran real: `1.5`, `1.5E+3`, `1.5D+3`, and Nastran's implicit exponent

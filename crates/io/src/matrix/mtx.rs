@@ -8,7 +8,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use stickslip_core::model::Matrix;
 
-use super::{parse_f64, parse_index, read_text, MatrixFileError, MAX_DIMENSION};
+use super::{finite_sums, parse_f64, parse_index, read_text, MatrixFileError, MAX_DIMENSION};
 
 #[derive(Clone, Copy, PartialEq)]
 enum Storage {
@@ -174,7 +174,7 @@ fn read_coordinate<'a>(
     }
     let m = SparseColMat::try_new_from_triplets(nrows, ncols, &triplets)
         .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))?;
-    Ok(Matrix::Sparse(m))
+    Ok(Matrix::Sparse(finite_sums(path, m)?))
 }
 
 fn read_array<'a>(
