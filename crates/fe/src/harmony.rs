@@ -365,16 +365,17 @@ impl Design {
         let radial = (self.envelope_radius / h).ceil() + 6.0;
         let axial = (z / h).ceil() + 8.0;
         let nodes_per_cell = if self.kind == SolidKind::Hex8 { 1.0 } else { 4.0 };
-        // The revolved solid fills about half of its (r, z) bounding box.
-        Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors) as usize
-            + 4 * 3 * self.blade_cells().iter().product::<usize>() * 4)
+        // The revolved solid fills about half of its (r, z) bounding box. In f64, saturating
+        // on conversion: a tiny element size from a damaged study file overflowed usize here.
+        let blade_cells: f64 = self.blade_cells().iter().map(|&c| c as f64).product();
+        Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors + 4.0 * 3.0 * blade_cells * 4.0) as usize)
     }
 
     fn sectors(&self) -> usize {
         // A multiple of 8 so that the blades' planes (0, 90, 180, 270 degrees) and the
         // accelerometers at 45 degrees fall on node lines.
         let s = (2.0 * PI * self.body_top_radius / self.element_size).ceil() as usize;
-        s.div_ceil(8).max(2) * 8
+        s.div_ceil(8).max(2).saturating_mul(8)
     }
 
     fn blade_cells(&self) -> [usize; 3] {

@@ -8,6 +8,7 @@
 //! SVG keeps text as text and needs no font; PNG rasterises labels with a system font found
 //! through fontconfig (on Debian, the package fonts-dejavu-core provides one).
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use plotters::coord::{CoordTranslate, Shift};
@@ -20,6 +21,36 @@ const SIZE: (u32, u32) = (1000, 650);
 const FONT: &str = "sans-serif";
 /// Decades shown below the largest value on a log axis.
 const LOG_DECADES: i32 = 9;
+
+/// Largest magnitude of an axis end. plotters steps through an axis to place its ticks: an
+/// infinite end (1e308 × 1.5 on a log axis, or the span of ±1e308 on a linear one) never
+/// ends that loop, and neither does a range too narrow for its magnitude to be stepped in f64.
+const AXIS_LIMIT: f64 = 1e300;
+/// Most decades a log axis spans (the tick loop of plotters counts decades).
+const LOG_AXIS_DECADES: f64 = 30.0;
+
+/// A finite linear axis range for data in `[lo, hi]`: ends clipped to ±1e300, the width at
+/// least 1e-9 of the magnitude (data outside is clipped by the chart, not drawn at infinity).
+pub fn linear_axis(lo: f64, hi: f64) -> Range<f64> {
+    let clip = |v: f64| if v.is_nan() { 0.0 } else { v.clamp(-AXIS_LIMIT, AXIS_LIMIT) };
+    let (lo, hi) = (clip(lo.min(hi)), clip(hi.max(lo)));
+    let magnitude = lo.abs().max(hi.abs());
+    let min_width = if magnitude > 0.0 { 1e-9 * magnitude } else { 1.0 };
+    if hi - lo >= min_width {
+        return lo..hi;
+    }
+    let mid = 0.5 * (lo + hi);
+    mid - min_width..mid + min_width
+}
+
+/// A finite positive log axis range for positive data in `[lo, hi]`, with a margin of a
+/// factor 1.5 each side: the top clipped to 1e300, the bottom at most 30 decades below it.
+pub fn log_axis(lo: f64, hi: f64) -> Range<f64> {
+    let hi = if hi.is_finite() && hi > 0.0 { hi.clamp(f64::MIN_POSITIVE, AXIS_LIMIT) } else { 1.0 };
+    let floor = (hi * 10f64.powf(-LOG_AXIS_DECADES)).max(f64::MIN_POSITIVE);
+    let lo = if lo.is_finite() && lo > 0.0 { lo.clamp(floor, hi) } else { floor };
+    lo / 1.5..hi * 1.5
+}
 
 /// One curve: a label and its points.
 struct Curve {
@@ -69,10 +100,17 @@ impl Chart {
         if x1 <= x0 {
             (x0, x1) = (x0 - 0.5 * x0.abs().max(1.0), x1 + 0.5 * x1.abs().max(1.0));
         }
+        // Axis ends stay finite (see `AXIS_LIMIT`): finite data only is kept, but its span or
+        // padding may overflow.
+        if self.log_y {
+            let x = linear_axis(x0, x1);
+            (x0, x1) = (x.start, x.end);
+        }
         let mut chart = ChartBuilder::on(&root);
         chart.caption(&title, (FONT, 22)).margin(15).x_label_area_size(45).y_label_area_size(85);
         if self.log_y {
-            (y0, y1) = (y0 / 1.5, y1 * 1.5);
+            let y = log_axis(y0, y1);
+            (y0, y1) = (y.start, y.end);
             let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;
             chart
                 .configure_mesh()
@@ -90,6 +128,8 @@ impl Chart {
             (y0, y1) = (y0 - pad, y1 + pad);
             let pad = 0.03 * (x1 - x0);
             (x0, x1) = (x0 - pad, x1 + pad);
+            let (x, y) = (linear_axis(x0, x1), linear_axis(y0, y1));
+            (x0, x1, y0, y1) = (x.start, x.end, y.start, y.end);
             let mut chart = chart.build_cartesian_2d(x0..x1, y0..y1).map_err(e)?;
             chart
                 .configure_mesh()

@@ -38,8 +38,45 @@ pub enum RecordsError {
     Mismatch { file: String, channel: String, what: String },
     #[error("no channel `{channel}` in {file}: available channels are {available:?}")]
     MissingChannel { file: String, channel: String, available: Vec<String> },
+    #[error("{file}: {quantity} is {value} at {location}: refusing to write a value that is not finite")]
+    NotFinite { file: String, quantity: String, location: String, value: f64 },
     #[error("{0}")]
     Invalid(String),
+}
+
+/// Refuse to write a non-finite `value` of `quantity` at `location` (a NaN in a result file
+/// reads back as a number the next tool cannot use, or not at all).
+fn finite(file: &Path, quantity: &str, location: impl FnOnce() -> String, value: f64) -> Result<(), RecordsError> {
+    if value.is_finite() {
+        return Ok(());
+    }
+    Err(RecordsError::NotFinite {
+        file: file.display().to_string(),
+        quantity: quantity.to_string(),
+        location: location(),
+        value,
+    })
+}
+
+/// Refuse a column (time, frequency) whose values do not strictly increase, naming the line.
+fn check_increasing(table: &Table, column: usize, rows: &[usize]) -> Result<(), RecordsError> {
+    let values = &table.data[column];
+    for w in rows.windows(2) {
+        let (a, b) = (values[w[0]], values[w[1]]);
+        if b <= a {
+            return Err(RecordsError::Parse {
+                file: table.file.clone(),
+                line: table.lines[w[1]],
+                what: format!(
+                    "column {} (`{}`): {b} does not increase on {a} (line {}); the rows must be in increasing order",
+                    column + 1,
+                    table.columns[column],
+                    table.lines[w[0]]
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// One sampled channel.
@@ -156,6 +193,14 @@ pub fn parse_table(text: &str, file: &str) -> Result<Table, RecordsError> {
                 line: i + 1,
                 what: format!("column {} (`{}`): `{}` is not a number", c + 1, columns[c], f.trim()),
             })?;
+            // `nan`, `inf` and overflowing literals parse as f64 but are no sample.
+            if !v.is_finite() {
+                return Err(RecordsError::Parse {
+                    file: file.into(),
+                    line: i + 1,
+                    what: format!("column {} (`{}`): `{}` is not a finite number", c + 1, columns[c], f.trim()),
+                });
+            }
             data[c].push(v);
         }
         rows.push(i + 1);
@@ -174,6 +219,9 @@ pub fn write_table(path: &Path, columns: &[String], rows: &[Vec<f64>]) -> Result
                 what: format!("a row of {} values for {} columns", row.len(), columns.len()),
             });
         }
+        for (c, &v) in row.iter().enumerate() {
+            finite(path, &format!("column `{}`", columns[c]), || format!("data row {}", s.lines().count()), v)?;
+        }
         let cells: Vec<String> = row.iter().map(|v| num(*v)).collect();
         s.push_str(&cells.join(","));
         s.push('\n');
@@ -188,7 +236,7 @@ fn uniform_rate(time: &[f64], lines: &[usize], file: &str) -> Result<f64, Record
         return Err(RecordsError::Header { file: file.into(), what: "a time record needs at least 2 samples".into() });
     }
     let dt = (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64;
-    if !(dt > 0.0 && dt.is_finite()) {
+    if !(dt > 0.0 && dt.is_finite() && (1.0 / dt).is_finite()) {
         return Err(RecordsError::Header { file: file.into(), what: "time must increase".into() });
     }
     for (j, (&t, &line)) in time.iter().zip(lines).enumerate() {
@@ -222,6 +270,7 @@ fn time_records_from_table(table: Table) -> Result<TimeRecords, RecordsError> {
             ),
         });
     }
+    check_increasing(&table, 0, &(0..table.lines.len()).collect::<Vec<_>>())?;
     let rate = uniform_rate(&table.data[0], &table.lines, &table.file)?;
     let start_s = table.data[0][0];
     let channels = table
@@ -244,6 +293,19 @@ fn num(x: f64) -> String {
 
 /// Write time records as CSV (`time_s` then one column per channel).
 pub fn write_time_csv(path: &Path, records: &TimeRecords) -> Result<(), RecordsError> {
+    finite(path, "the start time", || "the time column".into(), records.start_s)?;
+    let rate = records.sample_rate_hz;
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(RecordsError::Invalid(format!(
+            "{}: the sample rate is {rate} Hz, expected a finite rate > 0: refusing to write the time column",
+            path.display()
+        )));
+    }
+    for c in &records.channels {
+        for (j, &v) in c.values.iter().enumerate() {
+            finite(path, &format!("channel `{}`", c.column()), || format!("sample {}", j + 1), v)?;
+        }
+    }
     let mut s = String::from("time_s");
     for c in &records.channels {
         s.push(',');
@@ -273,7 +335,19 @@ pub fn time_records_from_uff(datasets: &[Dataset58], file: &str) -> Result<TimeR
             d.ids[0].trim().replace([' ', ',', ':'], "_")
         };
         let (start, dt) = match &d.abscissa {
-            Abscissa::Even { min, increment } => (*min, *increment),
+            Abscissa::Even { min, increment } => {
+                // The rate 1/dt must be finite too (a subnormal increment gives an infinite one).
+                if !(increment.is_finite() && *increment > 0.0 && (1.0 / increment).is_finite()) {
+                    return Err(RecordsError::Mismatch {
+                        file: file.into(),
+                        channel: name,
+                        what: format!(
+                            "has a time increment of {increment} s: time must increase at a finite sample rate"
+                        ),
+                    });
+                }
+                (*min, *increment)
+            }
             Abscissa::Uneven(x) => {
                 let lines: Vec<usize> = (1..=x.len()).collect();
                 let rate = uniform_rate(x, &lines, &format!("{file} (dataset `{name}`, point numbers as lines)"))?;
@@ -445,6 +519,10 @@ pub fn read_frf_csv(path: &Path) -> Result<Vec<FrfSet>, RecordsError> {
         };
         rows.entry(g).or_default().push(r);
     }
+    let freq_column = table.columns.iter().position(|c| c == "frequency_Hz").expect("found above");
+    for rs in rows.values() {
+        check_increasing(&table, freq_column, rs)?;
+    }
     Ok(rows
         .into_iter()
         .map(|(g, rs)| FrfSet {
@@ -492,7 +570,18 @@ pub fn write_frf_csv(path: &Path, sets: &[FrfSet]) -> Result<(), RecordsError> {
                 what: "differs in curves or length from the first FRF set".into(),
             });
         }
+        let level = set.level_n.map_or_else(String::new, |l| format!("level {l} N, "));
+        if let Some(l) = set.level_n {
+            finite(path, "the force level", || format!("FRF set {}", set.source), l)?;
+        }
         for (r, f) in set.frequency_hz.iter().enumerate() {
+            finite(path, "the frequency", || format!("{level}row {}", r + 1), *f)?;
+            for c in &set.curves {
+                let v = c.values[r];
+                let at = || format!("{level}{f} Hz");
+                finite(path, &format!("the real part of FRF `{}`", c.name), at, v.re)?;
+                finite(path, &format!("the imaginary part of FRF `{}`", c.name), at, v.im)?;
+            }
             if with_level {
                 let _ = write!(s, "{},", num(set.level_n.unwrap_or(f64::NAN)));
             }
@@ -527,7 +616,9 @@ pub fn frf_sets_from_uff(datasets: &[Dataset58], file: &str) -> Vec<FrfSet> {
                     .trim()
                     .strip_prefix("level ")
                     .and_then(|l| l.strip_suffix(" N"))
-                    .and_then(|l| l.parse().ok()),
+                    .and_then(|l| l.parse::<f64>().ok())
+                    // `level NaN N` is no level: left unknown, as an id2 without one.
+                    .filter(|l| l.is_finite()),
                 frequency_hz: d.x(),
                 curves: vec![FrfCurve {
                     name: d.ids[0].trim().replace([' ', ','], "_"),
@@ -563,6 +654,12 @@ pub fn write_frames(
     frames: &[Vec<f64>],
 ) -> Result<Vec<PathBuf>, RecordsError> {
     std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+    // Checked before any file is written, so that a refused frame leaves no partial set.
+    for (j, frame) in frames.iter().enumerate() {
+        for (name, v) in point_names.iter().zip(frame) {
+            finite(dir, quantity_column, || format!("point `{name}` of frame {j}"), *v)?;
+        }
+    }
     let digits = frames.len().saturating_sub(1).to_string().len().max(3);
     let mut written = Vec::with_capacity(frames.len());
     for (j, frame) in frames.iter().enumerate() {

@@ -313,7 +313,11 @@ impl Context<'_> {
         if t.is_empty() {
             return Ok(0.0);
         }
-        parse_real(t).ok_or_else(|| self.malformed(line, format!("{name} `{t}` is not a number")))
+        match parse_real(t) {
+            Some(x) if x.is_finite() => Ok(x),
+            Some(_) => Err(self.malformed(line, format!("{name} `{t}` is not a finite number"))),
+            None => Err(self.malformed(line, format!("{name} `{t}` is not a number"))),
+        }
     }
 
     fn axis(&self, text: &str, line: usize) -> Result<AxisSpec, UffError> {
@@ -450,10 +454,20 @@ fn parse_58(
     };
     let per_point = usize::from(!even) + if complex { 2 } else { 1 };
 
+    let data_line = cur.line + 1;
+    // Line of each value (ASCII), for the errors on values checked after reading.
+    let mut value_lines: Vec<usize> = Vec::new();
     let values: Vec<f64> = if binary {
         let size = if precision == Precision::Single { 4 } else { 8 };
-        let n_bytes = declared.max(0) as usize * per_point * size;
-        let data_line = cur.line + 1;
+        // Checked: a damaged point count must not overflow or reserve beyond the file.
+        let left = cur.bytes.len() - cur.pos;
+        let n_bytes = usize::try_from(declared.max(0)).ok().and_then(|d| d.checked_mul(per_point * size));
+        let Some(n_bytes) = n_bytes.filter(|&n| n <= left) else {
+            return Err(ctx.malformed(
+                data_line,
+                format!("binary data of {declared} points needs more bytes than the file has left ({left})"),
+            ));
+        };
         let end = cur.pos + n_bytes;
         if end > cur.bytes.len() {
             return Err(ctx.malformed(
@@ -497,7 +511,10 @@ fn parse_58(
             (Precision::Double, false, false) => &[13, 20],
             (Precision::Double, false, true) => &[13, 20, 20],
         };
-        let mut values = Vec::with_capacity(declared.max(0) as usize * per_point);
+        // Reserve no more than the rest of the file can hold (a value takes 13 characters at
+        // least): the declared count comes from the file and may be damaged.
+        let left = (cur.bytes.len() - cur.pos) / 13;
+        let mut values = Vec::with_capacity((declared.max(0) as usize).saturating_mul(per_point).min(left));
         loop {
             let l = cur.next_line().ok_or_else(|| ctx.malformed(open_line, "dataset 58 is not closed by `-1`"))?;
             if is_delimiter(l) {
@@ -510,12 +527,20 @@ fn parse_58(
                 let width = widths[w % widths.len()];
                 let f = field(&text, start, width);
                 if !f.trim().is_empty() {
-                    values.push(parse_real(f).ok_or_else(|| {
+                    let v = parse_real(f).ok_or_else(|| {
                         ctx.malformed(
                             cur.line,
                             format!("`{}` (columns {}-{}) is not a number", f.trim(), start + 1, start + width),
                         )
-                    })?);
+                    })?;
+                    if !v.is_finite() {
+                        return Err(ctx.malformed(
+                            cur.line,
+                            format!("`{}` (columns {}-{}) is not a finite number", f.trim(), start + 1, start + width),
+                        ));
+                    }
+                    values.push(v);
+                    value_lines.push(cur.line);
                 }
                 start += width;
                 w += 1;
@@ -523,6 +548,18 @@ fn parse_58(
         }
         values
     };
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        // Binary data (ASCII values are checked as they are read).
+        return Err(ctx.malformed(
+            data_line,
+            format!(
+                "value {} of the binary data (point {}) is {}, not a finite number",
+                i + 1,
+                i / per_point + 1,
+                values[i]
+            ),
+        ));
+    }
     if !values.len().is_multiple_of(per_point) {
         return Err(ctx.malformed(
             head_line + 12,
@@ -536,6 +573,38 @@ fn parse_58(
         found,
     });
     let offset = usize::from(!even);
+    // Time and frequency increase: a listed abscissa out of order, or an even one that does not
+    // advance, would make a record or FRF the analyses cannot use.
+    if even && found > 1 && x_inc <= 0.0 {
+        return Err(ctx.malformed(l7, format!("abscissa increment {x_inc} of {found} points: it must be > 0")));
+    }
+    if even && found > 1 {
+        // In f64 the points must still increase and stay finite (an increment below the
+        // resolution of the minimum, or a last point beyond 1.8e308, does not).
+        let x = |i: usize| x_min + i as f64 * x_inc;
+        if let Some(i) = (1..found).find(|&i| !(x(i).is_finite() && x(i) > x(i - 1))) {
+            return Err(ctx.malformed(
+                l7,
+                format!(
+                    "abscissa minimum {x_min} and increment {x_inc}: point {} is at {}, not above point {i}",
+                    i + 1,
+                    x(i)
+                ),
+            ));
+        }
+    }
+    if !even {
+        for p in 1..found {
+            let (a, b) = (values[(p - 1) * per_point], values[p * per_point]);
+            if b <= a {
+                let line = value_lines.get(p * per_point).copied().unwrap_or(data_line);
+                return Err(ctx.malformed(
+                    line,
+                    format!("abscissa value {b} of point {} does not increase on {a}: the points must be in increasing abscissa order", p + 1),
+                ));
+            }
+        }
+    }
     let abscissa = if even {
         Abscissa::Even { min: x_min, increment: x_inc }
     } else {
@@ -594,6 +663,39 @@ fn check(dataset: &Dataset58) -> Result<(), UffError> {
     if let Abscissa::Uneven(x) = &dataset.abscissa {
         if x.len() != dataset.len() {
             return Err(invalid(format!("{} abscissa values for {} ordinate values", x.len(), dataset.len())));
+        }
+    }
+    // A NaN written as text reads back as a malformed field (or as NaN in other tools).
+    let not_finite = |quantity: &str, v: &dyn std::fmt::Display| {
+        invalid(format!("{quantity} is {v}: refusing to write a value that is not finite"))
+    };
+    match &dataset.abscissa {
+        Abscissa::Even { min, increment } => {
+            for (q, v) in [("abscissa minimum", *min), ("abscissa increment", *increment)] {
+                if !v.is_finite() {
+                    return Err(not_finite(q, &v));
+                }
+            }
+        }
+        Abscissa::Uneven(x) => {
+            if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+                return Err(not_finite(&format!("abscissa value of point {}", i + 1), &x[i]));
+            }
+        }
+    }
+    if !dataset.z_value.is_finite() {
+        return Err(not_finite("z-axis value", &dataset.z_value));
+    }
+    match &dataset.ordinate {
+        Ordinate::Real(v) => {
+            if let Some(i) = v.iter().position(|v| !v.is_finite()) {
+                return Err(not_finite(&format!("ordinate of point {}", i + 1), &v[i]));
+            }
+        }
+        Ordinate::Complex(v) => {
+            if let Some(i) = v.iter().position(|v| !(v.re.is_finite() && v.im.is_finite())) {
+                return Err(not_finite(&format!("ordinate of point {}", i + 1), &v[i]));
+            }
         }
     }
     Ok(())

@@ -80,7 +80,7 @@ fn calculix_entry_beyond_the_dof_list_names_file_and_line() {
 fn abaqus_matrix_generate_sample() {
     let k = abaqus::read(&sample("tiny_STIF1.mtx")).unwrap();
     let m = abaqus::read(&sample("tiny_MASS1.mtx")).unwrap();
-    let model = model_from_pair(k, m);
+    let model = model_from_pair(k, m).unwrap();
     assert_eq!(names(&model), ["1.1", "1.2", "7.3"]);
     assert_matrix(&model.stiffness, &[&[4.0e3, -1.0e3, 0.0], &[-1.0e3, 2.0e3, -250.0], &[0.0, -250.0, 1.0e3]]);
     assert_matrix(&model.mass, &[&[2.0, 0.0, 0.0], &[0.0, 2.0, 0.0], &[0.0, 0.0, 0.5]]);

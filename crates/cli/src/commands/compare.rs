@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use plotters::prelude::*;
 use stickslip_core::signal::peaks::{peaks, Peak};
+use stickslip_io::plot;
 use stickslip_io::records::{self, FrfSet};
 use stickslip_io::uff;
 
@@ -261,13 +262,16 @@ where
     if x1 <= x0 {
         (x0, x1) = (x0 - 1.0, x1 + 1.0);
     }
+    // Finite axis ends whatever the data (an amplitude of 1e308 once made the log axis end at
+    // infinity, where plotting never finished).
+    let (x, y) = (plot::linear_axis(x0, x1), plot::log_axis(y0, y1));
     root.fill(&WHITE).map_err(e)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("{} at {} N: measured and simulated", g.output, g.level_n), ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(85)
-        .build_cartesian_2d(x0..x1, ((y0 / 1.5)..(y1 * 1.5)).log_scale())
+        .build_cartesian_2d(x, y.log_scale())
         .map_err(e)?;
     chart
         .configure_mesh()

@@ -74,6 +74,14 @@ pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
             let read = |p: &Path| -> anyhow::Result<LabelledMatrix> {
                 if is_matrix_market(p)? {
                     let m = mtx::read(p)?;
+                    if m.nrows() != m.ncols() {
+                        bail!(
+                            "{}: the matrix is {}x{}; a stiffness or mass matrix must be square",
+                            p.display(),
+                            m.nrows(),
+                            m.ncols()
+                        );
+                    }
                     let n = m.nrows();
                     let dofs =
                         (0..n).map(|i| stickslip_core::model::DofLabel::named(format!("dof{}", i + 1))).collect();
@@ -94,7 +102,9 @@ pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
                     m.matrix.ncols()
                 );
             }
-            Loaded { model: model_from_pair(k, m), fe: None }
+            let model = model_from_pair(k, m)
+                .with_context(|| format!("stiffness {} and mass {}", path.display(), mass.display()))?;
+            Loaded { model, fe: None }
         }
         "pch" | "bdf" | "dat" | "nas" => {
             let (k, m) = args.dmig.split_once(',').context("--dmig expects STIFFNESS,MASS matrix names")?;
@@ -173,6 +183,10 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     );
     let eff = effective_masses(model, &sol);
     let freqs = sol.modes.frequencies_hz();
+    // The solver refuses non-finite modes; a table of NaN is never written with success.
+    if let Some(r) = (0..freqs.len()).find(|&r| !(freqs[r].is_finite() && sol.residuals[r].is_finite())) {
+        bail!("mode {}: frequency {} Hz, residual {}: not finite, nothing written", r + 1, freqs[r], sol.residuals[r]);
+    }
     let mut table = String::new();
     table.push_str("mode,frequency_hz,eff_mass_x_kg,eff_mass_y_kg,eff_mass_z_kg,residual\n");
     println!(

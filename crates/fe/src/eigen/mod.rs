@@ -11,7 +11,6 @@ mod lanczos;
 pub mod ordering;
 
 pub use factor::ShiftedFactor;
-pub use lanczos::{modes_with_factor, solve};
 
 use faer::sparse::{SparseColMat, Triplet};
 use stickslip_core::model::{Matrix, Modes};
@@ -29,6 +28,8 @@ pub enum EigenError {
     Size { k_rows: usize, k_cols: usize, m_rows: usize, m_cols: usize },
     #[error("Lanczos did not converge in {restarts} restarts: {converged} of {requested} modes reached the tolerance (largest relative Ritz residual {worst:.2e}); ask for fewer modes or a shift nearer the wanted ones")]
     NotConverged { restarts: usize, converged: usize, requested: usize, worst: f64 },
+    #[error("the mass matrix is indefinite: {what}; M must be positive (semi)definite (check the sign and the assembly of the mass matrix)")]
+    MassIndefinite { what: String },
     #[error("mode {mode} has residual ||K phi - w^2 M phi|| / ||K phi|| = {residual:.2e} above {tolerance:.1e}: the factorisation is inaccurate (check the matrices for near-singular blocks)")]
     Inaccurate { mode: usize, residual: f64, tolerance: f64 },
 }
@@ -84,6 +85,71 @@ pub struct EigenSolution {
     /// Linear solves with the factor and Lanczos restarts used.
     pub solves: usize,
     pub restarts: usize,
+}
+
+/// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default); see
+/// [`check_mass`] for what is refused on top of the solver's own checks.
+pub fn solve(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    check_mass(m, None)?;
+    let solution = lanczos::solve(k, m, opts)?;
+    check_mass(m, Some(&solution))?;
+    Ok(solution)
+}
+
+/// As [`solve`], with an existing factorisation of `K − σM` (its shift is used).
+pub fn modes_with_factor(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    factor: &ShiftedFactor,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    check_mass(m, None)?;
+    let solution = lanczos::modes_with_factor(k, m, factor, opts)?;
+    check_mass(m, Some(&solution))?;
+    Ok(solution)
+}
+
+/// An indefinite M is refused: before solving, a negative diagonal entry (`eᵢᵀ M eᵢ < 0`);
+/// after, a mode whose mass `φᵀMφ` is not positive, or whose frequency, shape or residual is
+/// not finite (mass-normalising a direction of negative mass divides by the square root of a
+/// negative number: the solver's NaN residual passed its `>` test and the mode came out as
+/// f = 0). The Lanczos iteration itself assumes the M inner product.
+fn check_mass(m: &SparseColMat<usize, f64>, solution: Option<&EigenSolution>) -> Result<(), EigenError> {
+    let Some(sol) = solution else {
+        if m.nrows() == m.ncols() {
+            if let Some((i, d)) = diagonal(m).into_iter().enumerate().find(|(_, d)| d.is_nan() || *d < 0.0) {
+                return Err(EigenError::MassIndefinite { what: format!("diagonal entry {} is {d:e}", i + 1) });
+            }
+        }
+        return Ok(());
+    };
+    let shapes = &sol.modes.shapes;
+    let mut mx = vec![0.0; shapes.nrows()];
+    for c in 0..shapes.ncols() {
+        let x: Vec<f64> = (0..shapes.nrows()).map(|i| shapes[(i, c)]).collect();
+        mx.iter_mut().for_each(|v| *v = 0.0);
+        let a = m.as_ref();
+        for (j, &xj) in x.iter().enumerate() {
+            for (&i, &v) in a.symbolic().row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+                mx[i] += v * xj;
+            }
+        }
+        let mass: f64 = x.iter().zip(&mx).map(|(a, b)| a * b).sum();
+        let (omega, residual) = (sol.modes.omega[c], sol.residuals[c]);
+        if !(mass > 0.0 && mass.is_finite() && omega.is_finite() && residual.is_finite()) {
+            return Err(EigenError::MassIndefinite {
+                what: format!(
+                    "mode {} has modal mass phi^T M phi = {mass:e} (frequency {omega:e} rad/s, residual {residual:e})",
+                    c + 1
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A sparse copy of a model matrix (dense matrices keep their non-zeros only).

@@ -90,12 +90,50 @@ struct Reader<'a> {
 
 impl Reader<'_> {
     fn at(&self) -> Origin {
-        let line = 1 + self.bytes[..self.pos.min(self.bytes.len())].iter().filter(|&&b| b == b'\n').count();
+        self.origin(self.pos)
+    }
+
+    /// The line of byte `pos`. Counting newlines is linear in the file: call it for errors only.
+    fn origin(&self, pos: usize) -> Origin {
+        let line = 1 + self.bytes[..pos.min(self.bytes.len())].iter().filter(|&&b| b == b'\n').count();
         Origin { file: self.file.clone(), line }
     }
 
     fn err(&self, msg: impl Into<String>) -> MeshError {
         MeshError::Syntax { at: self.at(), msg: msg.into() }
+    }
+
+    /// A count of items of at least `bytes_each` bytes (binary) or `tokens_each` numbers
+    /// (ASCII, two bytes each at least: a digit and a separator), refused when the rest of the
+    /// file cannot hold that many. Counts are used to reserve memory: an unchecked one from a
+    /// damaged file would abort on a huge allocation.
+    fn count(&mut self, what: &str, bytes_each: usize, tokens_each: usize) -> Result<usize, MeshError> {
+        let start = self.mark();
+        let n = self.size(what)?;
+        let each = if self.binary { bytes_each } else { 2 * tokens_each };
+        self.bounded(n, each, start, what)
+    }
+
+    /// Where the next value starts, for its error messages (ASCII values may follow white space
+    /// and newlines; binary ones start right here).
+    fn mark(&mut self) -> usize {
+        if !self.binary {
+            self.skip_space();
+        }
+        self.pos
+    }
+
+    /// `n` items of `each` bytes at least, refused (naming the line of `start`) when the rest
+    /// of the file cannot hold them.
+    fn bounded(&self, n: u64, each: usize, start: usize, what: &str) -> Result<usize, MeshError> {
+        let left = self.bytes.len().saturating_sub(self.pos);
+        match usize::try_from(n) {
+            Ok(n) if n <= left / each.max(1) => Ok(n),
+            _ => Err(MeshError::Syntax {
+                at: self.origin(start),
+                msg: format!("{what} {n} is more than the rest of the file ({left} bytes) can hold"),
+            }),
+        }
     }
 
     fn skip_space(&mut self) {
@@ -139,11 +177,21 @@ impl Reader<'_> {
         })
     }
 
+    /// A Gmsh `int`: 32 bits in binary files, and held to that range in ASCII ones (a tag of
+    /// i64::MIN overflowed `abs`; a wider element type wrapped onto a supported one).
     fn int(&mut self, what: &str) -> Result<i64, MeshError> {
         if self.binary {
             Ok(i32::from_le_bytes(self.raw::<4>()?) as i64)
         } else {
-            self.ascii(what)
+            let start = self.mark();
+            let v: i64 = self.ascii(what)?;
+            if i32::try_from(v).is_err() {
+                return Err(MeshError::Syntax {
+                    at: self.origin(start),
+                    msg: format!("{what} {v} is not a 32-bit integer"),
+                });
+            }
+            Ok(v)
         }
     }
 
@@ -156,11 +204,15 @@ impl Reader<'_> {
     }
 
     fn float(&mut self, what: &str) -> Result<f64, MeshError> {
-        if self.binary {
-            Ok(f64::from_le_bytes(self.raw::<8>()?))
-        } else {
-            self.ascii(what)
+        let start = self.mark();
+        let x = if self.binary { f64::from_le_bytes(self.raw::<8>()?) } else { self.ascii(what)? };
+        if !x.is_finite() {
+            return Err(MeshError::Syntax {
+                at: self.origin(start),
+                msg: format!("{what} is {x}, expected a finite number"),
+            });
         }
+        Ok(x)
     }
 
     fn expect(&mut self, tag: &str) -> Result<(), MeshError> {
@@ -211,7 +263,11 @@ impl Reader<'_> {
                     seen_format = true;
                 }
                 "$PhysicalNames" => {
-                    let n: usize = self.ascii("the number of names")?;
+                    // ASCII in binary files too: `dim tag name` per line.
+                    self.skip_space();
+                    let start = self.pos;
+                    let n = self.ascii("the number of names")?;
+                    let n = self.bounded(n, 6, start, "the number of names")?;
                     for _ in 0..n {
                         let dim: i64 = self.ascii("a dimension")?;
                         let tag: i64 = self.ascii("a physical tag")?;
@@ -234,13 +290,13 @@ impl Reader<'_> {
                             for _ in 0..n_coords {
                                 self.float("a coordinate")?;
                             }
-                            let n_phys = self.size("a number of physical tags")?;
-                            let mut phys = Vec::with_capacity(n_phys as usize);
+                            let n_phys = self.count("a number of physical tags", 4, 1)?;
+                            let mut phys = Vec::with_capacity(n_phys);
                             for _ in 0..n_phys {
                                 phys.push(self.int("a physical tag")?.abs());
                             }
                             if dim > 0 {
-                                let n_bound = self.size("a number of bounding entities")?;
+                                let n_bound = self.count("a number of bounding entities", 4, 1)?;
                                 for _ in 0..n_bound {
                                     self.int("a bounding entity")?;
                                 }
@@ -262,7 +318,8 @@ impl Reader<'_> {
                         if parametric != 0 {
                             return Err(self.err("parametric node coordinates are not supported"));
                         }
-                        let n = self.size("a block size")? as usize;
+                        // A tag and three coordinates per node.
+                        let n = self.count("a block size", 32, 4)?;
                         let mut tags = Vec::with_capacity(n);
                         for _ in 0..n {
                             tags.push(self.size("a node tag")?);
@@ -286,15 +343,21 @@ impl Reader<'_> {
                     for _ in 0..blocks {
                         let dim = self.int("an entity dimension")?;
                         let entity = self.int("an entity tag")?;
-                        let etype = self.int("an element type")? as i32;
-                        let n = self.size("a block size")? as usize;
-                        let at = self.at();
-                        let Some((nn, kind)) = element_info(etype) else {
+                        let type_at = self.mark();
+                        let etype = self.int("an element type")?;
+                        // Checked before the block size, which depends on it; an ASCII type beyond
+                        // i32 is refused, not wrapped onto a supported one.
+                        let info = i32::try_from(etype).ok().and_then(element_info);
+                        let Some((nn, kind)) = info else {
+                            let at = self.origin(type_at);
                             return Err(MeshError::UnsupportedElement { at, kind: format!("Gmsh type {etype}") });
                         };
-                        if let Some(name) = unsupported_volume(etype) {
+                        if let Some(name) = unsupported_volume(etype as i32) {
+                            let at = self.origin(type_at);
                             return Err(MeshError::UnsupportedElement { at, kind: name.into() });
                         }
+                        // A tag and `nn` node tags per element.
+                        let n = self.count("a block size", 8 * (1 + nn), 1 + nn)?;
                         let phys = entity_groups.get(&(dim, entity)).cloned().unwrap_or_default();
                         let mut nodes = vec![0usize; nn];
                         for _ in 0..n {

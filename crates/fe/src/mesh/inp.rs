@@ -214,7 +214,15 @@ impl Parser {
 
     fn float(&self, l: &Line, f: &str, what: &str) -> Result<f64, MeshError> {
         // Fortran-style exponents (1.0D3) appear in older decks.
-        f.replace(['d', 'D'], "e").parse::<f64>().map_err(|_| self.syntax(l, format!("expected {what}, got {f:?}")))
+        let x = f
+            .replace(['d', 'D'], "e")
+            .parse::<f64>()
+            .map_err(|_| self.syntax(l, format!("expected {what}, got {f:?}")))?;
+        // `nan`, `inf` and overflowing literals (1e999) parse, but are no coordinate or property.
+        if !x.is_finite() {
+            return Err(self.syntax(l, format!("expected {what}, got {f:?}, which is not finite")));
+        }
+        Ok(x)
     }
 
     fn node_ref(&self, l: &Line, id: u64, what: &str) -> Result<usize, MeshError> {

@@ -92,6 +92,13 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
                 MatrixFileError::parse(path, line_of(k), format!("expected an integer {what}, got {:?}", get(k)))
             })
         };
+        // Components are 0 (scalar point) to 6; a larger one would wrap onto another DOF as u8.
+        let component = |k: usize, what: &str| -> Result<u8, MatrixFileError> {
+            match int(k, what)? {
+                c @ 0..=6 => Ok(c as u8),
+                c => Err(MatrixFileError::parse(path, line_of(k), format!("{what} {c} is not a component 0..=6"))),
+            }
+        };
         let name = get(0).to_string();
         if name.is_empty() {
             return Err(MatrixFileError::parse(path, line_of(0), "DMIG entry without a matrix name"));
@@ -131,7 +138,7 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
                 format!("column of matrix {name} before its header entry (GJ = 0)"),
             )
         })?;
-        let cj = int(2, "column component (CJ)")? as u8;
+        let cj = component(2, "column component (CJ)")?;
         // Terms in groups of four fields (G, C, A, B), the first group after field 4.
         let mut k = 4;
         while k < f.len() {
@@ -140,7 +147,7 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
                 continue;
             }
             let g = int(k, "row grid (G)")?;
-            let c = int(k + 1, "row component (C)")? as u8;
+            let c = component(k + 1, "row component (C)")?;
             if get(k + 2).is_empty() {
                 return Err(MatrixFileError::parse(
                     path,
@@ -170,8 +177,9 @@ pub fn read(path: &Path) -> Result<Vec<DmigMatrix>, MatrixFileError> {
         } else {
             let t: Vec<_> =
                 p.entries.iter().map(|(_, r, c, v)| faer::sparse::Triplet::new(index(r), index(c), *v)).collect();
-            faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
-                .map_err(|e| MatrixFileError::invalid(path, format!("matrix {name}: {e:?}")))?
+            let m = faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
+                .map_err(|e| MatrixFileError::invalid(path, format!("matrix {name}: {e:?}")))?;
+            super::finite_sums(path, m)?
         };
         out.push(DmigMatrix { name, symmetric: p.symmetric, matrix: LabelledMatrix::nodal(keys, matrix) });
     }
@@ -191,5 +199,5 @@ pub fn read_model(path: &Path, stiffness: &str, mass: &str) -> Result<LinearMode
     };
     let k = take(stiffness)?;
     let m = take(mass)?;
-    Ok(model_from_pair(k, m))
+    model_from_pair(k, m).map_err(|e| MatrixFileError::invalid(path, format!("{stiffness} and {mass}: {e}")))
 }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use faer::sparse::{SparseColMat, Triplet};
-use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix};
+use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix, ModelError};
 
 pub mod abaqus;
 pub mod calculix;
@@ -42,6 +42,11 @@ impl MatrixFileError {
         MatrixFileError::Invalid { path: path.to_path_buf(), message: message.into() }
     }
 }
+
+/// Largest matrix dimension a file may declare: 10 million DOFs, 30 times the largest model
+/// of the benchmarks. A sparse matrix allocates a column pointer per column whatever its
+/// entries, so a damaged size line would otherwise abort on a huge allocation.
+pub(crate) const MAX_DIMENSION: usize = 10_000_000;
 
 /// Read a whole text file, the error naming it.
 pub(crate) fn read_text(path: &Path) -> Result<String, MatrixFileError> {
@@ -103,9 +108,33 @@ impl SymmetricTriplets {
     }
 
     pub(crate) fn build(self, path: &Path, n: usize) -> Result<SparseColMat<usize, f64>, MatrixFileError> {
-        SparseColMat::try_new_from_triplets(n, n, &self.triplets)
-            .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))
+        let m = SparseColMat::try_new_from_triplets(n, n, &self.triplets)
+            .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))?;
+        finite_sums(path, m)
     }
+}
+
+/// Duplicate entries are summed: finite values can sum to infinity (1e308 + 1e308).
+pub(crate) fn finite_sums(
+    path: &Path,
+    m: SparseColMat<usize, f64>,
+) -> Result<SparseColMat<usize, f64>, MatrixFileError> {
+    let a = m.as_ref();
+    for j in 0..a.ncols() {
+        if let Some(p) = a.val_of_col(j).iter().position(|v| !v.is_finite()) {
+            let i = a.symbolic().row_idx_of_col_raw(j)[p];
+            return Err(MatrixFileError::invalid(
+                path,
+                format!(
+                    "the entries at row {}, column {} sum to {}, which is not finite",
+                    i + 1,
+                    j + 1,
+                    a.val_of_col(j)[p]
+                ),
+            ));
+        }
+    }
+    Ok(m)
 }
 
 /// Parse a Nastran/Fortran real: `1.5`, `1.5E+3`, `1.5D+3`, and Nastran's implicit exponent
@@ -114,8 +143,9 @@ pub(crate) fn parse_real(path: &Path, line: usize, token: &str, what: &str) -> R
     let t = token.trim();
     let mut s = t.replace(['D', 'd'], "E");
     if !s.contains(['E', 'e']) {
-        // A sign after the first character starts the exponent.
-        if let Some(p) = s[1..].find(['+', '-']).map(|p| p + 1) {
+        // A sign after the first character starts the exponent (char indices: the token may
+        // start with a multi-byte character, or be empty).
+        if let Some((p, _)) = s.char_indices().skip(1).find(|(_, c)| matches!(c, '+' | '-')) {
             s.insert(p, 'E');
         }
     }
@@ -139,7 +169,17 @@ impl LabelledMatrix {
 /// An undamped model from a stiffness and a mass over possibly different DOF lists (a DOF
 /// with no mass entry, say): the model's DOFs are the union, in the stiffness's order then
 /// the mass's extra DOFs.
-pub fn model_from_pair(stiffness: LabelledMatrix, mass: LabelledMatrix) -> LinearModel {
+///
+/// Each matrix must be square over its DOF list, and the model passes the checks of
+/// [`LinearModel::new`] (a rectangular mass once came out of the eigensolver as f = 0 with a
+/// NaN residual).
+pub fn model_from_pair(stiffness: LabelledMatrix, mass: LabelledMatrix) -> Result<LinearModel, ModelError> {
+    for (what, m) in [("K (stiffness)", &stiffness), ("M (mass)", &mass)] {
+        let (rows, cols, n) = (m.matrix.nrows(), m.matrix.ncols(), m.dofs.len());
+        if rows != n || cols != n {
+            return Err(ModelError::WrongSize { what: what.into(), rows, cols, expected: n });
+        }
+    }
     let mut dofs = stiffness.dofs.clone();
     let mut index: std::collections::HashMap<String, usize> =
         dofs.iter().enumerate().map(|(i, d)| (d.name.clone(), i)).collect();
@@ -161,11 +201,5 @@ pub fn model_from_pair(stiffness: LabelledMatrix, mass: LabelledMatrix) -> Linea
         }
         SparseColMat::try_new_from_triplets(n, n, &t).expect("indices are in range")
     };
-    LinearModel {
-        mass: Matrix::Sparse(remap(&mass)),
-        stiffness: Matrix::Sparse(remap(&stiffness)),
-        damping: Damping::None,
-        dofs,
-        loads: vec![],
-    }
+    LinearModel::new(Matrix::Sparse(remap(&mass)), Matrix::Sparse(remap(&stiffness)), Damping::None, dofs, vec![])
 }

@@ -8,7 +8,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use stickslip_core::model::Matrix;
 
-use super::{parse_f64, parse_index, read_text, MatrixFileError};
+use super::{finite_sums, parse_f64, parse_index, read_text, MatrixFileError, MAX_DIMENSION};
 
 #[derive(Clone, Copy, PartialEq)]
 enum Storage {
@@ -39,6 +39,18 @@ pub fn read(path: &Path) -> Result<Matrix, MatrixFileError> {
     };
     let nrows = count(dims[0], "number of rows")?;
     let ncols = count(dims[1], "number of columns")?;
+    if nrows.max(ncols) > MAX_DIMENSION {
+        return Err(MatrixFileError::parse(
+            path,
+            size_line,
+            format!(
+                "a {nrows}x{ncols} matrix is larger than stickslip reads (at most {MAX_DIMENSION} rows and columns)"
+            ),
+        ));
+    }
+    // Every entry (coordinate) or value (array) takes two bytes at least, a digit and a
+    // separator: counts the file cannot hold are refused before anything is reserved.
+    let room = text.len() / 2;
     if symmetric && nrows != ncols {
         return Err(MatrixFileError::parse(
             path,
@@ -49,9 +61,29 @@ pub fn read(path: &Path) -> Result<Matrix, MatrixFileError> {
     match storage {
         Storage::Coordinate => {
             let nnz = count(dims[2], "number of entries")?;
+            if nnz > room {
+                return Err(MatrixFileError::parse(
+                    path,
+                    size_line,
+                    format!(
+                        "the size line announces {nnz} entries, more than the file ({} bytes) can hold",
+                        text.len()
+                    ),
+                ));
+            }
             read_coordinate(path, &mut data, nrows, ncols, nnz, symmetric, size_line)
         }
-        Storage::Array => read_array(path, &mut data, nrows, ncols, symmetric, size_line),
+        Storage::Array => {
+            let values = if symmetric { nrows.checked_mul(nrows + 1).map(|v| v / 2) } else { nrows.checked_mul(ncols) };
+            if values.is_none_or(|v| v > room) {
+                return Err(MatrixFileError::parse(
+                    path,
+                    size_line,
+                    format!("a {nrows}x{ncols} array needs more values than the file ({} bytes) can hold", text.len()),
+                ));
+            }
+            read_array(path, &mut data, nrows, ncols, symmetric, size_line)
+        }
     }
 }
 
@@ -142,7 +174,7 @@ fn read_coordinate<'a>(
     }
     let m = SparseColMat::try_new_from_triplets(nrows, ncols, &triplets)
         .map_err(|e| MatrixFileError::invalid(path, format!("cannot build the sparse matrix: {e:?}")))?;
-    Ok(Matrix::Sparse(m))
+    Ok(Matrix::Sparse(finite_sums(path, m)?))
 }
 
 fn read_array<'a>(

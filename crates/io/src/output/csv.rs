@@ -69,6 +69,25 @@ pub(crate) fn template(levels: &[LevelResult]) -> Result<Option<&PointRecord>, O
     Ok(Some(first))
 }
 
+/// Refuse results holding a value that is not finite, naming its column, level and point.
+pub(crate) fn check_finite(path: &Path, levels: &[LevelResult], columns: &[String]) -> Result<(), OutputError> {
+    for l in levels {
+        for p in &l.points {
+            for (c, v) in frf_row(l.level_n, p).into_iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(OutputError::NotFinite {
+                        path: path.to_path_buf(),
+                        quantity: format!("column `{}`", columns[c]),
+                        location: format!("level {} N, point at {} Hz", l.level_n, p.frequency_hz),
+                        value: v,
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn write_file(path: &Path, text: &str) -> Result<(), OutputError> {
     let io = |source| OutputError::Io { path: path.to_path_buf(), source };
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
@@ -94,7 +113,9 @@ pub fn write_frf_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
     let Some(first) = template(levels)? else {
         return write_file(path, &(frf_columns(&PointRecord::default()).join(",") + "\n"));
     };
-    text.push_str(&frf_columns(first).join(","));
+    let columns = frf_columns(first);
+    check_finite(path, levels, &columns)?;
+    text.push_str(&columns.join(","));
     text.push('\n');
     for l in levels {
         for p in &l.points {
@@ -139,6 +160,24 @@ pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> 
     }
     text.push('\n');
     let omega = 2.0 * std::f64::consts::PI * p.frequency_hz;
+    if n_t > 0 && !(omega.is_finite() && omega > 0.0) {
+        return Err(OutputError::NotFinite {
+            path: path.to_path_buf(),
+            quantity: "the period (time_s column)".into(),
+            location: format!("the point at {} Hz", p.frequency_hz),
+            value: 1.0 / p.frequency_hz,
+        });
+    }
+    for (name, v) in &columns {
+        if let Some(j) = v.iter().position(|x| !x.is_finite()) {
+            return Err(OutputError::NotFinite {
+                path: path.to_path_buf(),
+                quantity: format!("series `{name}`"),
+                location: format!("sample {j} of the point at {} Hz", p.frequency_hz),
+                value: v[j],
+            });
+        }
+    }
     let mut row = Vec::with_capacity(columns.len() + 2);
     for j in 0..n_t {
         let theta = 2.0 * std::f64::consts::PI * j as f64 / n_t as f64;

@@ -124,6 +124,9 @@ pub enum OutputError {
     /// The time series of one point must have the same number of samples.
     #[error("{}: {message}", path.display())]
     TimeData { path: PathBuf, message: String },
+    /// A NaN or infinity among the results: written, it would read back as no number.
+    #[error("{}: {quantity} is {value} at {location}: refusing to write a value that is not finite", path.display())]
+    NotFinite { path: PathBuf, quantity: String, location: String, value: f64 },
     #[error("{0}")]
     Plot(String),
 }

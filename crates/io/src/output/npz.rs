@@ -4,7 +4,7 @@ use std::path::Path;
 
 use npyz::WriterBuilder;
 
-use super::csv::{frf_columns, frf_row, template};
+use super::csv::{check_finite, frf_columns, frf_row, template};
 use super::{LevelResult, OutputError};
 
 /// Write `frf.npz`: one 1-D float64 array per column of `frf.csv`, same names and row order,
@@ -15,6 +15,7 @@ pub fn write_frf_npz(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
         return npyz::npz::NpzWriter::create(path).map(drop).map_err(io);
     };
     let columns = frf_columns(first);
+    check_finite(path, levels, &columns)?;
     let rows: Vec<Vec<f64>> = levels.iter().flat_map(|l| l.points.iter().map(move |p| frf_row(l.level_n, p))).collect();
     let n_rows = rows.len() as u64;
     let mut npz = npyz::npz::NpzWriter::create(path).map_err(io)?;
