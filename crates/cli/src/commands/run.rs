@@ -114,7 +114,13 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     if !args.quiet {
         eprintln!(
             "total: {:.2} s",
-            timings.iter().filter(|(s, _)| !s.starts_with("level ")).map(|(_, t)| t).sum::<f64>()
+            // Levels run in parallel (their wall clock is a stage of its own) and indented
+            // sub-stages are parts of the stage above them.
+            timings
+                .iter()
+                .filter(|(s, _)| !s.starts_with("level ") && !s.starts_with(' '))
+                .map(|(_, t)| t)
+                .sum::<f64>()
         );
     }
     let incomplete: Vec<String> = runs

@@ -12,5 +12,5 @@ pub use damping::Damping;
 pub use dof::DofLabel;
 pub use linear::{LinearModel, ModelError, NamedVector};
 pub use matrix::Matrix;
-pub use modes::Modes;
+pub use modes::{symmetric_eigen, Modes};
 pub use nonlinear::{relative_direction, stiffness_along, ElementSite, NonlinearModel};

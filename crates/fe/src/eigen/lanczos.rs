@@ -7,13 +7,12 @@
 //! Krylov spaces here are small (tens of vectors) next to the cost of a solve.
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::SparseColMat;
 use faer::{Accum, Mat, MatRef, Par, Side};
-use stickslip_core::model::Modes;
+use stickslip_core::model::{symmetric_eigen, Modes};
 
-use super::dense::symmetric_eigen;
-use super::{default_shift, EigenError, EigenOptions, EigenSolution, ShiftedFactor};
+use super::product::symmetric_product;
+use super::{default_shift, EigenError, EigenOptions, EigenSolution, ShiftInvert, ShiftedFactor};
 
 /// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default).
 pub fn solve(
@@ -38,7 +37,7 @@ fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Re
 pub fn modes_with_factor(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
-    factor: &ShiftedFactor,
+    factor: &dyn ShiftInvert,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
     check_sizes(k, m)?;
@@ -67,11 +66,11 @@ pub fn modes_with_factor(
     {
         let mut x = Mat::<f64>::from_fn(n, 1, |i, _| pseudo_random(i));
         let mut mx = Mat::<f64>::zeros(n, 1);
-        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
         factor.solve_in_place(mx.as_mut());
         solves += 1;
         x.copy_from(&mx);
-        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
         let norm = dot(x.as_ref(), mx.as_ref()).sqrt();
         v.col_mut(0).copy_from(x.col(0) / norm);
         mv.col_mut(0).copy_from(mx.col(0) / norm);
@@ -89,7 +88,7 @@ pub fn modes_with_factor(
             solves += 1;
             let (mdone, mut mnext) = mv.as_mut().split_at_col_mut(j + 1);
             let mut z = mnext.rb_mut().subcols_mut(0, 1);
-            sparse_dense_matmul(z.rb_mut(), Accum::Replace, m.as_ref(), w.rb(), 1.0, par);
+            symmetric_product(z.rb_mut(), m.as_ref(), w.rb());
             // Two passes of classical Gram-Schmidt in the M inner product.
             for _ in 0..2 {
                 let mut c = coef.as_mut().subrows_mut(0, j + 1);
@@ -102,13 +101,13 @@ pub fn modes_with_factor(
             }
             // M w afresh: after cancellation the updated z is not accurate enough to
             // normalise with when β is small (near-invariant subspaces, clustered modes).
-            sparse_dense_matmul(z.rb_mut(), Accum::Replace, m.as_ref(), w.rb(), 1.0, par);
+            symmetric_product(z.rb_mut(), m.as_ref(), w.rb());
             let beta = dot(w.rb(), z.rb()).max(0.0).sqrt();
             h[(j + 1, j)] = beta;
             let scale = h[(j, j)].abs().max(f64::MIN_POSITIVE);
             if beta <= 1e-14 * scale {
                 // Invariant subspace: continue with a fresh direction orthogonal to the basis.
-                restart_direction(m, &mut v, &mut mv, j + 1, par);
+                restart_direction(m, &mut v, &mut mv, j + 1);
                 h[(j + 1, j)] = 0.0;
             } else {
                 let (mut w, mut z) = (w, z);
@@ -164,13 +163,12 @@ fn finish(
     theta: &[f64],
     wanted: &[usize],
     sigma: f64,
-    factor: &ShiftedFactor,
+    factor: &dyn ShiftInvert,
     solves: usize,
     restarts: usize,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
     let ncv = y.nrows();
-    let par = Par::rayon(0);
     let mut pairs: Vec<(f64, usize)> = wanted.iter().map(|&i| (sigma + 1.0 / theta[i], i)).collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let ysel = Mat::<f64>::from_fn(ncv, pairs.len(), |r, c| y[(r, pairs[c].1)]);
@@ -183,14 +181,14 @@ fn finish(
     // |λ − σ| / |λ_out − σ|, λ_out the nearest eigenvalue outside it); two passes at most.
     let mut passes = 0;
     let (omega, residuals) = loop {
-        let (omega, residuals) = rayleigh_quotients(k, m, &mut shapes, sigma, par);
+        let (omega, residuals) = rayleigh_quotients(k, m, &mut shapes, sigma);
         let worst = residuals.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map(|(c, &r)| (c, r));
         match worst {
             Some((c, r)) if r > opts.residual_limit => {
                 if passes == REFINEMENT_PASSES {
                     return Err(EigenError::Inaccurate { mode: c + 1, residual: r, tolerance: opts.residual_limit });
                 }
-                refine(k, m, factor, &mut shapes, par)?;
+                refine(k, m, factor, &mut shapes)?;
                 passes += 1;
             }
             _ => break (omega, residuals),
@@ -218,13 +216,12 @@ fn rayleigh_quotients(
     m: &SparseColMat<usize, f64>,
     shapes: &mut Mat<f64>,
     sigma: f64,
-    par: Par,
 ) -> (Vec<f64>, Vec<f64>) {
     let (n, p) = (shapes.nrows(), shapes.ncols());
     let mut kx = Mat::<f64>::zeros(n, p);
     let mut mx = Mat::<f64>::zeros(n, p);
-    sparse_dense_matmul(kx.as_mut(), Accum::Replace, k.as_ref(), shapes.as_ref(), 1.0, par);
-    sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), shapes.as_ref(), 1.0, par);
+    symmetric_product(kx.as_mut(), k.as_ref(), shapes.as_ref());
+    symmetric_product(mx.as_mut(), m.as_ref(), shapes.as_ref());
     let mut omega = Vec::with_capacity(p);
     let mut residuals = Vec::with_capacity(p);
     for c in 0..p {
@@ -252,18 +249,17 @@ fn rayleigh_quotients(
 fn refine(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
-    factor: &ShiftedFactor,
+    factor: &dyn ShiftInvert,
     shapes: &mut Mat<f64>,
-    par: Par,
 ) -> Result<(), EigenError> {
     let (n, p) = (shapes.nrows(), shapes.ncols());
     let mut x = Mat::<f64>::zeros(n, p);
-    sparse_dense_matmul(x.as_mut(), Accum::Replace, m.as_ref(), shapes.as_ref(), 1.0, par);
+    symmetric_product(x.as_mut(), m.as_ref(), shapes.as_ref());
     factor.solve_in_place(x.as_mut());
     let mut kx = Mat::<f64>::zeros(n, p);
     let mut mx = Mat::<f64>::zeros(n, p);
-    sparse_dense_matmul(kx.as_mut(), Accum::Replace, k.as_ref(), x.as_ref(), 1.0, par);
-    sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+    symmetric_product(kx.as_mut(), k.as_ref(), x.as_ref());
+    symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
     let kr = x.transpose() * &kx;
     let mr = x.transpose() * &mx;
     let mr = Mat::from_fn(p, p, |i, j| 0.5 * (mr[(i, j)] + mr[(j, i)]));
@@ -286,17 +282,17 @@ fn refine(
 }
 
 /// Replace column `j` of `v` by a new M-normalised vector M-orthogonal to columns `0..j`.
-fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Mat<f64>, j: usize, par: Par) {
+fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Mat<f64>, j: usize) {
     let n = v.nrows();
     for attempt in 0..8 {
         let mut x = Mat::<f64>::from_fn(n, 1, |i, _| pseudo_random(i + (attempt + 1) * (j + 7) * 7919));
         let mut mx = Mat::<f64>::zeros(n, 1);
         for _ in 0..2 {
-            sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+            symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
             let c = v.subcols(0, j).transpose() * &mx;
             x -= v.subcols(0, j) * &c;
         }
-        sparse_dense_matmul(mx.as_mut(), Accum::Replace, m.as_ref(), x.as_ref(), 1.0, par);
+        symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
         let norm = dot(x.as_ref(), mx.as_ref()).max(0.0).sqrt();
         if norm > 1e-8 {
             v.col_mut(j).copy_from(x.col(0) / norm);
@@ -317,7 +313,7 @@ fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Ma
 fn block_krylov(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
-    factor: &ShiftedFactor,
+    factor: &dyn ShiftInvert,
     opts: &EigenOptions,
 ) -> Result<Option<EigenSolution>, EigenError> {
     let n = k.nrows();
@@ -328,7 +324,6 @@ fn block_krylov(
     // recurrence needs several blocks between restarts to filter (measured on a 25,830-DOF
     // slab: with room for two blocks per cycle 100 modes did not converge in 200 restarts).
     let max_dim = (3 * nev).max(nev + 8 * b).min(n);
-    let par = Par::rayon(0);
     let mut v = Mat::<f64>::zeros(n, max_dim + b);
     let mut mv = Mat::<f64>::zeros(n, max_dim + b);
     let mut h = Mat::<f64>::zeros(max_dim + b, max_dim + b);
@@ -337,10 +332,10 @@ fn block_krylov(
     // Start block: OP applied to pseudo-random vectors.
     let mut w = Mat::<f64>::from_fn(n, b, |i, j| pseudo_random(i + j * n));
     let mut mw = Mat::<f64>::zeros(n, b);
-    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+    symmetric_product(mw.as_mut(), m.as_ref(), w.as_ref());
     factor.solve_in_place(mw.as_mut());
     solves += b;
-    let mut dim = append_block(m, &mut v, &mut mv, 0, mw, par);
+    let mut dim = append_block(m, &mut v, &mut mv, 0, mw);
     // Columns [start, dim) form the last block.
     let mut start = 0;
     while dim > start {
@@ -349,7 +344,7 @@ fn block_krylov(
         w = mv.subcols(start, nb).to_owned();
         factor.solve_in_place(w.as_mut());
         solves += nb;
-        let new_dim = append_block(m, &mut v, &mut mv, dim, w.clone(), par);
+        let new_dim = append_block(m, &mut v, &mut mv, dim, w.clone());
         // H[0..new_dim, block] = (M V)ᵀ W: the projection of OP on the basis.
         let coef = mv.subcols(0, new_dim).transpose() * &w;
         for c in 0..nb {
@@ -426,35 +421,39 @@ fn append_block(
     mv: &mut Mat<f64>,
     dim: usize,
     mut w: Mat<f64>,
-    par: Par,
 ) -> usize {
     let n = w.nrows();
     let mut mw = Mat::<f64>::zeros(n, w.ncols());
-    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+    symmetric_product(mw.as_mut(), m.as_ref(), w.as_ref());
     let reference = (0..w.ncols()).map(|c| dot(w.col(c).as_mat(), mw.col(c).as_mat())).fold(0.0, f64::max);
-    for _ in 0..2 {
+    for pass in 0..2 {
         if dim > 0 {
             for _ in 0..2 {
                 let c = mv.subcols(0, dim).transpose() * &w;
                 w -= v.subcols(0, dim) * &c;
+                mw -= mv.subcols(0, dim) * &c;
             }
         }
-        sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
+        if pass == 1 {
+            // M w afresh once: after cancellation the updated M w is not accurate enough for
+            // the Gram matrix of a block nearly inside the basis. The first pass's update
+            // suffices to drop and scale its directions (two products with M instead of four).
+            symmetric_product(mw.as_mut(), m.as_ref(), w.as_ref());
+        }
         let g = w.transpose() * &mw;
         let g = Mat::<f64>::from_fn(g.nrows(), g.ncols(), |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
-        let Ok(evd) = g.self_adjoint_eigen(Side::Lower) else {
+        let Some((mu, u)) = symmetric_eigen(g.as_ref()) else {
             return dim;
         };
         // Directions whose M-norm fell below 1e-10 of the block's are already in the basis.
-        let kept: Vec<usize> = (0..g.nrows()).filter(|&i| evd.S()[i] > 1e-20 * reference).collect();
+        let kept: Vec<usize> = (0..g.nrows()).filter(|&i| mu[i] > 1e-20 * reference).collect();
         if kept.is_empty() || dim + kept.len() > v.ncols() {
             return dim;
         }
-        let q = Mat::<f64>::from_fn(g.nrows(), kept.len(), |r, c| evd.U()[(r, kept[c])] / evd.S()[kept[c]].sqrt());
+        let q = Mat::<f64>::from_fn(g.nrows(), kept.len(), |r, c| u[(r, kept[c])] / mu[kept[c]].sqrt());
         w = &w * &q;
-        mw = Mat::<f64>::zeros(n, w.ncols());
+        mw = &mw * &q;
     }
-    sparse_dense_matmul(mw.as_mut(), Accum::Replace, m.as_ref(), w.as_ref(), 1.0, par);
     let nb = w.ncols();
     v.subcols_mut(dim, nb).copy_from(&w);
     mv.subcols_mut(dim, nb).copy_from(&mw);

@@ -5,12 +5,15 @@
 //! The shift σ lies below the lowest eigenvalue by default (a small negative value), so
 //! free-free structures, whose rigid-body modes sit at ω = 0, are solved as they are. Every
 //! returned mode's residual `‖Kφ − ω²Mφ‖ / ‖Kφ‖` is computed and returned.
-mod dense;
 mod factor;
 mod lanczos;
 pub mod ordering;
+mod product;
+mod update;
 
-pub use factor::ShiftedFactor;
+pub use factor::{ShiftInvert, ShiftedFactor};
+pub use product::{symmetric_product, symmetric_times};
+pub use update::LowRankUpdate;
 
 use faer::sparse::{SparseColMat, Triplet};
 use stickslip_core::model::{Matrix, Modes};
@@ -100,11 +103,12 @@ pub fn solve(
     Ok(solution)
 }
 
-/// As [`solve`], with an existing factorisation of `K − σM` (its shift is used).
+/// As [`solve`], with an existing factorisation of `K − σM` or an update of one (its shift is
+/// used).
 pub fn modes_with_factor(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
-    factor: &ShiftedFactor,
+    factor: &dyn ShiftInvert,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
     check_mass(m, None)?;
@@ -128,17 +132,9 @@ fn check_mass(m: &SparseColMat<usize, f64>, solution: Option<&EigenSolution>) ->
         return Ok(());
     };
     let shapes = &sol.modes.shapes;
-    let mut mx = vec![0.0; shapes.nrows()];
+    let mx = symmetric_times(m.as_ref(), shapes.as_ref());
     for c in 0..shapes.ncols() {
-        let x: Vec<f64> = (0..shapes.nrows()).map(|i| shapes[(i, c)]).collect();
-        mx.iter_mut().for_each(|v| *v = 0.0);
-        let a = m.as_ref();
-        for (j, &xj) in x.iter().enumerate() {
-            for (&i, &v) in a.symbolic().row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-                mx[i] += v * xj;
-            }
-        }
-        let mass: f64 = x.iter().zip(&mx).map(|(a, b)| a * b).sum();
+        let mass: f64 = (0..shapes.nrows()).map(|i| shapes[(i, c)] * mx[(i, c)]).sum();
         let (omega, residual) = (sol.modes.omega[c], sol.residuals[c]);
         if !(mass > 0.0 && mass.is_finite() && omega.is_finite() && residual.is_finite()) {
             return Err(EigenError::MassIndefinite {

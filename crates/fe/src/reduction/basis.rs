@@ -3,13 +3,12 @@
 use std::time::Instant;
 
 use faer::prelude::Solve;
-use faer::sparse::linalg::matmul::dense_sparse_matmul;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
-use faer::{Accum, Mat, Par, Side};
-use stickslip_core::model::{LinearModel, Matrix};
+use faer::{Mat, Side};
+use stickslip_core::model::{symmetric_eigen, LinearModel, Matrix};
 
 use super::{reduced_model, Method, Reduction, ReductionError, ReductionOptions, Release};
-use crate::eigen::{self, to_sparse, EigenOptions, EigenSolution, ShiftedFactor};
+use crate::eigen::{self, symmetric_times, to_sparse, EigenOptions, EigenSolution, LowRankUpdate, ShiftedFactor};
 
 /// Retained (r) and eliminated (e) DOFs.
 struct Partition {
@@ -123,17 +122,11 @@ fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
 }
 
 /// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry). For a sparse A
-/// the product is formed as `(Tᵀ A) T` with `Tᵀ` stored by columns, so that each stored entry
-/// of A updates one contiguous column of `m` values.
+/// the product is formed as `Tᵀ (A T)`, `A T` by [`symmetric_times`] (one pass over A).
 pub(super) fn project_matrix(a: &Matrix, t: &Mat<f64>) -> Mat<f64> {
     let p = match a {
         Matrix::Dense(d) => t.transpose() * (d * t),
-        Matrix::Sparse(s) => {
-            let tt = t.transpose().to_owned();
-            let mut ta = Mat::<f64>::zeros(t.ncols(), s.ncols());
-            dense_sparse_matmul(ta.as_mut(), Accum::Replace, tt.as_ref(), s.as_ref(), 1.0, Par::rayon(0));
-            &ta * t
-        }
+        Matrix::Sparse(s) => t.transpose() * symmetric_times(s.as_ref(), t.as_ref()),
     };
     Mat::from_fn(p.nrows(), p.ncols(), |i, j| 0.5 * (p[(i, j)] + p[(j, i)]))
 }
@@ -147,9 +140,9 @@ const DEPENDENCE: f64 = 1e-14;
 /// Rayleigh-Ritz on the span of `x`: an M-orthonormal, K-orthogonal basis of it (the
 /// K-orthogonalisation of the paper's Section 3.3), vectors ordered by increasing
 /// `φᵀKφ`. Linearly dependent vectors are dropped.
-fn orthonormalise(model: &LinearModel, x: Mat<f64>) -> Mat<f64> {
+fn orthonormalise(model: &LinearModel, x: Mat<f64>) -> Result<Mat<f64>, ReductionError> {
     if x.ncols() == 0 {
-        return x;
+        return Ok(x);
     }
     let mut gm = project_matrix(&model.mass, &x);
     // Unit M-norm columns first, so that the dependence test is scale-free.
@@ -159,15 +152,22 @@ fn orthonormalise(model: &LinearModel, x: Mat<f64>) -> Mat<f64> {
             gm[(i, j)] *= scale[i] * scale[j];
         }
     }
-    let evd = gm.self_adjoint_eigen(Side::Lower).expect("symmetric eigensolver on a small Gram matrix");
-    let mu: Vec<f64> = (0..gm.nrows()).map(|i| evd.S()[i]).collect();
+    let (mu, u) = symmetric_eigen(gm.as_ref()).ok_or_else(gram_failed)?;
     let mu_max = mu.iter().cloned().fold(0.0, f64::max);
     let kept: Vec<usize> = (0..mu.len()).filter(|&i| mu[i] > DEPENDENCE * mu_max).collect();
-    let q = Mat::<f64>::from_fn(x.ncols(), kept.len(), |r, c| evd.U()[(r, kept[c])] * scale[r] / mu[kept[c]].sqrt());
+    let q = Mat::<f64>::from_fn(x.ncols(), kept.len(), |r, c| u[(r, kept[c])] * scale[r] / mu[kept[c]].sqrt());
     let z = &x * &q;
     let gk = project_matrix(&model.stiffness, &z);
-    let evd = gk.self_adjoint_eigen(Side::Lower).expect("symmetric eigensolver on a small Gram matrix");
-    &z * evd.U()
+    let (kappa, u) = symmetric_eigen(gk.as_ref()).ok_or_else(gram_failed)?;
+    let mut order: Vec<usize> = (0..kappa.len()).collect();
+    order.sort_by(|&a, &b| kappa[a].total_cmp(&kappa[b]));
+    Ok(&z * Mat::<f64>::from_fn(u.nrows(), u.ncols(), |r, c| u[(r, order[c])]))
+}
+
+fn gram_failed() -> ReductionError {
+    ReductionError::Model(stickslip_core::model::ModelError::Invalid(
+        "the Gram matrices of the reduction basis have no accurate eigendecomposition (a basis of nearly dependent vectors)".into(),
+    ))
 }
 
 fn eigen_options(opts: &ReductionOptions, count: usize) -> EigenOptions {
@@ -240,10 +240,10 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
 /// eigenfrequencies as the full one.
 pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
-    let (part, psi, sol, mut stages) = static_and_free_modes(model, &k, &m, opts)?;
+    let (part, psi, sol, mut stages, _) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
-    let dynamic = orthonormalise(model, clean(&phi, &psi, &part));
+    let dynamic = orthonormalise(model, clean(&phi, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
     let freqs = frequencies(&sol);
     finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
@@ -251,7 +251,9 @@ pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduct
 
 /// Wall-clock seconds per named stage.
 type Stages = Vec<(&'static str, f64)>;
-type StaticAndFree = (Partition, Mat<f64>, EigenSolution, Stages);
+/// The partition, the constraint modes, the free modes, the stage times and the factorisation
+/// of K when one served both (kept for the released modes of [`enriched`]).
+type StaticAndFree = (Partition, Mat<f64>, EigenSolution, Stages, Option<ShiftedFactor>);
 
 /// Constraint modes and the free modes. When no shift is asked and K is positive definite, a
 /// single LDLᵀ of K serves both (shift 0 is then below the spectrum); otherwise (a free-free
@@ -278,7 +280,7 @@ fn static_and_free_modes(
                     ("free modes", t_modes),
                     ("constraint modes", start.elapsed().as_secs_f64()),
                 ];
-                return Ok((part, psi, sol, stages));
+                return Ok((part, psi, sol, stages, Some(factor)));
             }
         }
     }
@@ -286,7 +288,7 @@ fn static_and_free_modes(
     let start = Instant::now();
     let sol = eigen::solve(k, m, &eig)?;
     stages.push(("free modes", start.elapsed().as_secs_f64()));
-    Ok((part, psi, sol, stages))
+    Ok((part, psi, sol, stages, None))
 }
 
 fn static_part(
@@ -314,17 +316,31 @@ pub fn enriched(
 ) -> Result<Reduction, ReductionError> {
     let n = model.n_dofs();
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
-    let (part, psi, sol, mut stages) = static_and_free_modes(model, &k, &m, opts)?;
+    let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let k_released = released_stiffness(&k, releases, n)?;
-    let rel = eigen::solve(&k_released, &m, &eigen_options(opts, release_modes.max(1)))?;
+    let eig = eigen_options(opts, release_modes.max(1));
+    // The factor of K serves the released structure too, through a rank-r update
+    // (`LowRankUpdate`); when the release opens a mechanism at that shift, `K_released` is
+    // factorised at the default (negative) shift instead.
+    let updated = factor.as_ref().and_then(|f| {
+        let directions = Mat::<f64>::from_fn(n, releases.len(), |i, j| releases[j].direction[i]);
+        let stiffness: Vec<f64> = releases.iter().map(|r| r.stiffness).collect();
+        LowRankUpdate::new(f, directions, &stiffness).ok()
+    });
+    let rel = match &updated {
+        Some(update) => eigen::modes_with_factor(&k_released, &m, update, &eig)?,
+        None => eigen::solve(&k_released, &m, &eig)?,
+    };
+    drop(updated);
+    drop(factor);
     stages.push(("released modes", start.elapsed().as_secs_f64()));
     let start = Instant::now();
     let (nf, nrel) = (opts.modes, release_modes.min(rel.modes.omega.len()));
     let mut x = Mat::<f64>::zeros(n, nf + nrel);
     x.subcols_mut(0, nf).copy_from(sol.modes.shapes.subcols(0, nf));
     x.subcols_mut(nf, nrel).copy_from(rel.modes.shapes.subcols(0, nrel));
-    let dynamic = orthonormalise(model, clean(&x, &psi, &part));
+    let dynamic = orthonormalise(model, clean(&x, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
     let (mut f, mut r) = frequencies(&sol);
     f.truncate(nf);

@@ -77,6 +77,7 @@ impl Study {
                 let started = std::time::Instant::now();
                 let red = reduce(&full, r, &releases).map_err(|k| err(r.at, k))?;
                 timings.push(("modes and reduction".into(), started.elapsed().as_secs_f64()));
+                timings.extend(red.stages.iter().map(|(stage, secs)| (format!("  {stage}"), *secs)));
                 (red.model.clone(), Some(red))
             }
         };
