@@ -52,7 +52,7 @@ impl<'a> LowRankUpdate<'a> {
         // An eigenvalue of S at round-off of the compliances 1/k_j: S is singular, and so is
         // the changed matrix.
         let scale = stiffness.iter().map(|k| 1.0 / k).fold(0.0, f64::max);
-        if mu.iter().any(|m| !(m.abs() > 1e-10 * scale)) {
+        if mu.iter().any(|m| m.is_nan() || m.abs() <= 1e-10 * scale) {
             return Err(singular());
         }
         let s_inv = Mat::<f64>::from_fn(r, r, |i, j| (0..r).map(|l| q[(i, l)] * q[(j, l)] / mu[l]).sum());
