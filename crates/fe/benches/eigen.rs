@@ -37,6 +37,7 @@ fn main() {
     }
     let fe = FeModel::assemble(mesh).expect("assembly");
     let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
+    let (k, m) = (k.into_owned(), m.into_owned());
     let t = Instant::now();
     let factor = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), 0.0).expect("factor");
     println!(

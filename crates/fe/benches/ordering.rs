@@ -20,7 +20,7 @@ fn main() {
     for r in if refinements.is_empty() { vec![1.0] } else { refinements } {
         let mesh = Design::refined(r).build(Configuration::Assembly).expect("mesh");
         let fe = FeModel::assemble(mesh).expect("assembly");
-        let k = to_sparse(&fe.model.stiffness);
+        let k = to_sparse(&fe.model.stiffness).into_owned();
         let n = k.nrows();
         println!("refinement {r}: {n} DOFs, {} stored entries of K", k.compute_nnz());
         let orderings: Vec<(&str, Box<Ordering>)> = vec![

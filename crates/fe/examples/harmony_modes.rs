@@ -38,6 +38,7 @@ fn main() {
         let fe = FeModel::assemble(mesh).expect("assembly");
         let n = fe.model.n_dofs();
         let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
+        let (k, m) = (k.into_owned(), m.into_owned());
         let sol = solve(&k, &m, &EigenOptions { count: 30, ..Default::default() }).expect("modes");
         // Effective masses along x, y, z: (φᵀ M r)² for the rigid translations r.
         let mut eff = Vec::new();

@@ -13,6 +13,7 @@ fn axial_modes(design: &Design, count: usize) -> (Vec<f64>, f64) {
     let mesh = design.build(Configuration::Assembly).expect("a buildable design");
     let fe = FeModel::assemble(mesh).expect("assembly");
     let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
+    let (k, m) = (k.into_owned(), m.into_owned());
     let sol = solve(&k, &m, &EigenOptions { count, ..Default::default() }).expect("modes");
     let top = fe.dof(harmony::accelerometer(0), 3).expect("body top DOF");
     let amp: Vec<f64> = (0..count).map(|j| sol.modes.shapes[(top, j)].abs()).collect();

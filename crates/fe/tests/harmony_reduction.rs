@@ -28,6 +28,7 @@ fn free_mode_reduction_keeps_the_modes_and_the_frf_of_the_full_model() {
 
     // Full model: enough modes to cover the FRF band and keep its frequencies off them.
     let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
+    let (k, m) = (k.into_owned(), m.into_owned());
     let full = solve(&k, &m, &EigenOptions { count: 40, ..Default::default() }).unwrap();
     let f_full = full.modes.frequencies_hz();
     eprintln!("full model: mode {MODES} at {:.1} Hz, mode 40 at {:.1} Hz", f_full[MODES - 1], f_full[39]);

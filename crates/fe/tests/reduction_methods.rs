@@ -198,9 +198,11 @@ fn enrichment_keeps_the_released_joint_modes_exact() {
     let mut t = Vec::new();
     let (a, b) = (case.retained[1], case.retained[2]);
     spring(&mut t, a, Some(b), -case.joint_stiffness);
-    let released_k =
-        faer::sparse::ops::add(stickslip_fe::eigen::to_sparse(&case.model.stiffness).as_ref(), sparse(n, &t).as_ref())
-            .unwrap();
+    let released_k = faer::sparse::ops::add(
+        stickslip_fe::eigen::to_sparse(&case.model.stiffness).as_ref().as_ref(),
+        sparse(n, &t).as_ref(),
+    )
+    .unwrap();
     let mut released = case.model.clone();
     released.stiffness = Matrix::Sparse(released_k);
     let exact = released.dense_modes().unwrap();

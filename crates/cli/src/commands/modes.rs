@@ -85,7 +85,7 @@ pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
                     let n = m.nrows();
                     let dofs =
                         (0..n).map(|i| stickslip_core::model::DofLabel::named(format!("dof{}", i + 1))).collect();
-                    Ok(LabelledMatrix { dofs, matrix: to_sparse(&m) })
+                    Ok(LabelledMatrix { dofs, matrix: to_sparse(&m).into_owned() })
                 } else {
                     Ok(abaqus::read(p)?)
                 }
@@ -169,6 +169,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let loaded = load(&args.model)?;
     let model = &loaded.model;
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (k, m) = (&*k, &*m);
     let opts = EigenOptions { count: args.count, shift: shift_from_hz(args.shift), ..Default::default() };
     let start = Instant::now();
     eprintln!("solving for {} modes ...", args.count);

@@ -54,6 +54,8 @@ pub struct ShiftedFactor {
     shift: f64,
     negative_pivots: usize,
     par: Par,
+    /// Whether the analysed pattern holds M's (false after a factorisation of K alone).
+    pattern_has_mass: bool,
 }
 
 impl ShiftedFactor {
@@ -65,43 +67,26 @@ impl ShiftedFactor {
         mass: Option<SparseColMatRef<'_, usize, f64>>,
         shift: f64,
     ) -> Result<Self, EigenError> {
-        let a = shifted(stiffness, mass, shift)?;
-        // METIS's nested dissection leaves the smallest factor on 3-D meshes (Harmony at
-        // 306k DOFs: 220 M entries against 299 M for minimum degree, numeric factorisation
-        // 10 s against 34 s; BENCHMARKS.md). Minimum degree can win on small or thin models,
-        // where its analysis is cheap: both are analysed there and the smaller factor kept.
-        let analyse = |ordering: SymmetricOrdering<'_, usize>| {
-            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ordering, CholeskySymbolicParams::default())
-                .map_err(|e| EigenError::Factorisation(format!("symbolic analysis failed: {e:?}")))
-        };
-        let metis = super::ordering::metis_nested_dissection(a.symbolic()).map(|fwd| {
-            let inv = super::ordering::inverse(&fwd);
-            (fwd, inv)
-        });
-        let symbolic = match &metis {
-            Some((fwd, inv)) => {
-                let nd = analyse(SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, a.nrows())))?;
-                if a.nrows() <= AMD_ALSO_BELOW {
-                    let amd = analyse(SymmetricOrdering::Amd)?;
-                    if amd.len_val() < nd.len_val() {
-                        amd
-                    } else {
-                        nd
-                    }
-                } else {
-                    nd
-                }
+        // At σ = 0 K itself is factorised: no copy of it (0.66 GB at 306k DOFs), and a pattern
+        // that may lack M's entries (see `refactor`).
+        let owned;
+        let (a, pattern_has_mass) = match mass {
+            Some(m) if shift != 0.0 => {
+                owned = shifted(stiffness, Some(m), shift)?;
+                (owned.as_ref(), true)
             }
-            None => analyse(SymmetricOrdering::Amd)?,
+            _ => (stiffness, mass.is_none()),
         };
+        let symbolic = analyse(a)?;
         let mut f = ShiftedFactor {
             symbolic: Arc::new(symbolic),
             values: Vec::new(),
             shift,
             negative_pivots: 0,
             par: Par::rayon(0),
+            pattern_has_mass,
         };
-        f.factor_numeric(a.as_ref())?;
+        f.factor_numeric(a)?;
         Ok(f)
     }
 
@@ -113,6 +98,10 @@ impl ShiftedFactor {
         shift: f64,
     ) -> Result<(), EigenError> {
         let a = shifted(stiffness, mass, shift)?;
+        if mass.is_some() && !self.pattern_has_mass {
+            self.symbolic = Arc::new(analyse(a.as_ref())?);
+            self.pattern_has_mass = true;
+        }
         self.shift = shift;
         self.factor_numeric(a.as_ref())
     }
@@ -215,6 +204,38 @@ impl ShiftedFactor {
         let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), self.par));
         ldlt.solve_in_place_with_conj(Conj::No, rhs, self.par, MemStack::new(&mut mem));
     }
+}
+
+/// Symbolic analysis of the pattern of `a`: ordering, elimination tree, supernodes.
+fn analyse(a: SparseColMatRef<'_, usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
+    // METIS's nested dissection leaves the smallest factor on 3-D meshes (Harmony at
+    // 306k DOFs: 220 M entries against 299 M for minimum degree, numeric factorisation
+    // 10 s against 34 s; BENCHMARKS.md). Minimum degree can win on small or thin models,
+    // where its analysis is cheap: both are analysed there and the smaller factor kept.
+    let analyse_with = |ordering: SymmetricOrdering<'_, usize>| {
+        factorize_symbolic_cholesky(a.symbolic(), Side::Lower, ordering, CholeskySymbolicParams::default())
+            .map_err(|e| EigenError::Factorisation(format!("symbolic analysis failed: {e:?}")))
+    };
+    let metis = super::ordering::metis_nested_dissection(a.symbolic()).map(|fwd| {
+        let inv = super::ordering::inverse(&fwd);
+        (fwd, inv)
+    });
+    Ok(match &metis {
+        Some((fwd, inv)) => {
+            let nd = analyse_with(SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, a.nrows())))?;
+            if a.nrows() <= AMD_ALSO_BELOW {
+                let amd = analyse_with(SymmetricOrdering::Amd)?;
+                if amd.len_val() < nd.len_val() {
+                    amd
+                } else {
+                    nd
+                }
+            } else {
+                nd
+            }
+        }
+        None => analyse_with(SymmetricOrdering::Amd)?,
+    })
 }
 
 /// `K − σM` on the union of the two patterns (`K` alone without mass).

@@ -148,10 +148,11 @@ fn check_mass(m: &SparseColMat<usize, f64>, solution: Option<&EigenSolution>) ->
     Ok(())
 }
 
-/// A sparse copy of a model matrix (dense matrices keep their non-zeros only).
-pub fn to_sparse(m: &Matrix) -> SparseColMat<usize, f64> {
+/// A model matrix as sparse: a sparse one is borrowed (a copy of K and M of a 300k-DOF model
+/// is 1.3 GB), a dense one keeps its non-zeros.
+pub fn to_sparse(m: &Matrix) -> std::borrow::Cow<'_, SparseColMat<usize, f64>> {
     match m {
-        Matrix::Sparse(s) => s.clone(),
+        Matrix::Sparse(s) => std::borrow::Cow::Borrowed(s),
         Matrix::Dense(d) => {
             let mut t = Vec::new();
             for j in 0..d.ncols() {
@@ -161,7 +162,9 @@ pub fn to_sparse(m: &Matrix) -> SparseColMat<usize, f64> {
                     }
                 }
             }
-            SparseColMat::try_new_from_triplets(d.nrows(), d.ncols(), &t).expect("indices are in range")
+            std::borrow::Cow::Owned(
+                SparseColMat::try_new_from_triplets(d.nrows(), d.ncols(), &t).expect("indices are in range"),
+            )
         }
     }
 }

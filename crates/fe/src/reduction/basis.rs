@@ -211,6 +211,7 @@ fn finish(
 pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
     let part = partition(model, &opts.retained)?;
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (k, m) = (&*k, &*m);
     let start = Instant::now();
     let (kee, mee) = (interior_block(&k, &part), interior_block(&m, &part));
     let factor =
@@ -240,6 +241,7 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
 /// eigenfrequencies as the full one.
 pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, _) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
@@ -316,6 +318,7 @@ pub fn enriched(
 ) -> Result<Reduction, ReductionError> {
     let n = model.n_dofs();
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, &k, &m, opts)?;
     let start = Instant::now();
     let k_released = released_stiffness(&k, releases, n)?;
