@@ -173,7 +173,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let opts = EigenOptions { count: args.count, shift: shift_from_hz(args.shift), ..Default::default() };
     let start = Instant::now();
     eprintln!("solving for {} modes ...", args.count);
-    let sol = eigen::solve(&k, &m, &opts)?;
+    let sol = eigen::solve(k, m, &opts)?;
     eprintln!(
         "modes: {:.2} s ({} solves, {} restarts, shift {:.4e} rad^2/s^2, {} eigenvalues below it)",
         start.elapsed().as_secs_f64(),

@@ -213,10 +213,10 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
     let (k, m) = (&*k, &*m);
     let start = Instant::now();
-    let (kee, mee) = (interior_block(&k, &part), interior_block(&m, &part));
+    let (kee, mee) = (interior_block(k, &part), interior_block(m, &part));
     let factor =
         ShiftedFactor::new(kee.as_ref(), Some(mee.as_ref()), 0.0).map_err(ReductionError::InteriorMechanism)?;
-    let psi = constraint_modes(&k, &part, &factor);
+    let psi = constraint_modes(k, &part, &factor);
     let mut stages = vec![("constraint modes", start.elapsed().as_secs_f64())];
     let start = Instant::now();
     let (dynamic, freqs) = if opts.modes > 0 {
@@ -242,7 +242,7 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
 pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduction, ReductionError> {
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
     let (k, m) = (&*k, &*m);
-    let (part, psi, sol, mut stages, _) = static_and_free_modes(model, &k, &m, opts)?;
+    let (part, psi, sol, mut stages, _) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
     let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
     let dynamic = orthonormalise(model, clean(&phi, &psi, &part))?;
@@ -319,9 +319,9 @@ pub fn enriched(
     let n = model.n_dofs();
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
     let (k, m) = (&*k, &*m);
-    let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, &k, &m, opts)?;
+    let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
-    let k_released = released_stiffness(&k, releases, n)?;
+    let k_released = released_stiffness(k, releases, n)?;
     let eig = eigen_options(opts, release_modes.max(1));
     // The factor of K serves the released structure too, through a rank-r update
     // (`LowRankUpdate`); when the release opens a mechanism at that shift, `K_released` is
@@ -332,8 +332,8 @@ pub fn enriched(
         LowRankUpdate::new(f, directions, &stiffness).ok()
     });
     let rel = match &updated {
-        Some(update) => eigen::modes_with_factor(&k_released, &m, update, &eig)?,
-        None => eigen::solve(&k_released, &m, &eig)?,
+        Some(update) => eigen::modes_with_factor(&k_released, m, update, &eig)?,
+        None => eigen::solve(&k_released, m, &eig)?,
     };
     drop(updated);
     drop(factor);
