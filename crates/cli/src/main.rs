@@ -14,6 +14,9 @@ mod commands;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Worker threads of every parallel stage (default: one per core, or RAYON_NUM_THREADS)
+    #[arg(long, global = true)]
+    threads: Option<usize>,
 }
 
 #[derive(Subcommand)]
@@ -34,6 +37,16 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        if n == 0 {
+            eprintln!("error: --threads must be at least 1");
+            return ExitCode::FAILURE;
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+            eprintln!("error: cannot start {n} worker threads: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
     let result = match cli.command {
         Command::Run(a) => commands::run::main(a),
         Command::Modes(a) => commands::modes::main(a),

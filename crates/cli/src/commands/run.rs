@@ -18,9 +18,6 @@ pub struct Args {
     /// Output directory (created if needed).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Worker threads for the force levels (default: one per core).
-    #[arg(long)]
-    pub threads: Option<usize>,
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
@@ -50,7 +47,6 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             eprintln!("{stage}: {secs:.2} s");
         }
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
 
     let bars = MultiProgress::new();
     if args.quiet {
@@ -61,31 +57,29 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .progress_chars("=> ");
     let (start_hz, end_hz) = (study.sweep.start_hz, study.sweep.end_hz);
     let started = Instant::now();
-    let runs: Vec<anyhow::Result<(LevelRun, f64)>> = pool.install(|| {
-        excitation
-            .levels_n
-            .par_iter()
-            .map(|&level| {
-                let level_started = Instant::now();
-                let bar = bars.add(ProgressBar::new(1000));
-                bar.set_style(style.clone());
-                bar.set_prefix(format!("{level} N"));
-                let mut observer = |p: &Point, done: f64| {
-                    bar.set_position((done * 1000.0) as u64);
-                    bar.set_message(format!("{:.2} Hz", p.lambda / (2.0 * std::f64::consts::PI)));
-                };
-                let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
-                    .with_context(|| format!("level {level} N"))?;
-                let secs = level_started.elapsed().as_secs_f64();
-                bar.finish_with_message(format!(
-                    "{} points, {}, {secs:.2} s",
-                    run.result.points.len(),
-                    describe_termination(&run.termination)
-                ));
-                Ok((run, secs))
-            })
-            .collect()
-    });
+    let runs: Vec<anyhow::Result<(LevelRun, f64)>> = excitation
+        .levels_n
+        .par_iter()
+        .map(|&level| {
+            let level_started = Instant::now();
+            let bar = bars.add(ProgressBar::new(1000));
+            bar.set_style(style.clone());
+            bar.set_prefix(format!("{level} N"));
+            let mut observer = |p: &Point, done: f64| {
+                bar.set_position((done * 1000.0) as u64);
+                bar.set_message(format!("{:.2} Hz", p.lambda / (2.0 * std::f64::consts::PI)));
+            };
+            let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
+                .with_context(|| format!("level {level} N"))?;
+            let secs = level_started.elapsed().as_secs_f64();
+            bar.finish_with_message(format!(
+                "{} points, {}, {secs:.2} s",
+                run.result.points.len(),
+                describe_termination(&run.termination)
+            ));
+            Ok((run, secs))
+        })
+        .collect();
     let runs: Vec<(LevelRun, f64)> = runs.into_iter().collect::<anyhow::Result<_>>()?;
     let elapsed = started.elapsed();
     for (run, secs) in &runs {
