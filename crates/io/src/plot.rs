@@ -135,8 +135,8 @@ impl Chart {
                 .configure_mesh()
                 .x_desc(&self.x_label)
                 .y_desc(&self.y_label)
-                .x_label_formatter(&|x| tick(*x))
-                .y_label_formatter(&|y| tick(*y))
+                .x_label_formatter(&|x| tick(*x, x1 - x0))
+                .y_label_formatter(&|y| tick(*y, y1 - y0))
                 .label_style((FONT, 15))
                 .draw()
                 .map_err(e)?;
@@ -186,7 +186,10 @@ impl Chart {
 }
 
 /// A tick label: plain decimals for moderate magnitudes, exponent form otherwise.
-fn tick(v: f64) -> String {
+/// A tick label; a tick within round-off of zero on an axis of width `span` is 0 (the tick
+/// positions are computed in floating point: "-1.39e-17" appeared on slider-velocity plots).
+fn tick(v: f64, span: f64) -> String {
+    let v = if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v };
     if v == 0.0 || (1e-2..1e5).contains(&v.abs()) {
         let s = format!("{v:.3}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
@@ -338,4 +341,16 @@ pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat
         }
     }
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_at_round_off_of_zero_read_zero() {
+        // The tick at zero of a velocity axis [-0.14, 0.12] came out as -1.39e-17.
+        assert_eq!(super::tick(-1.39e-17, 0.26), "0");
+        assert_eq!(super::tick(0.05, 0.26), "0.05");
+        // A genuinely small tick on a small axis keeps its value.
+        assert_eq!(super::tick(2.0e-9, 1.0e-8), "2.00e-9");
+    }
 }
