@@ -1,10 +1,10 @@
-//! Thick-restart Lanczos (Wu & Simon, SIAM J. Matrix Anal. Appl. 22, 2000) for the
-//! shift-invert operator `OP = (K − σM)⁻¹ M`, self-adjoint in the M inner product. Its largest
-//! eigenvalues θ = 1/(λ − σ) are the eigenvalues λ = ω² nearest σ.
+//! Thick-restart Lanczos (Wu & Simon, SIAM J. Matrix Anal. Appl. 22, 2000), in blocks and
+//! single-vector, for the shift-invert operator `OP = (K − σM)⁻¹ M`, self-adjoint in the M
+//! inner product. Its largest eigenvalues θ = 1/(λ − σ) are the eigenvalues λ = ω² nearest σ.
 //!
 //! Both `V` and `MV` are kept, so every step costs one solve and two products with M; the
 //! basis is fully reorthogonalised (twice, which is enough in floating point) because the
-//! Krylov spaces here are small (tens of vectors) next to the cost of a solve.
+//! Krylov spaces here are small (tens to hundreds of vectors) next to the cost of a solve.
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMat;

@@ -1,6 +1,8 @@
 //! The lowest modes of large sparse `(K, M)` (paper Section 3.3: the 34 modes of the reduced
-//! model): shift-invert Lanczos in the M inner product with full reorthogonalisation and thick
-//! restart, on a sparse LDLᵀ of `K − σM` ([`ShiftedFactor`]).
+//! model): block shift-invert Lanczos in the M inner product with full reorthogonalisation and
+//! thick restart (single-vector thick restart as a fallback), on a sparse LDLᵀ of `K − σM`
+//! ([`ShiftedFactor`], ordered by METIS's nested dissection) or on a low-rank update of one
+//! ([`LowRankUpdate`]: the structure with its joints released, without a second factorisation).
 //!
 //! The shift σ lies below the lowest eigenvalue by default (a small negative value), so
 //! free-free structures, whose rigid-body modes sit at ω = 0, are solved as they are. Every
