@@ -185,9 +185,9 @@ impl Chart {
     }
 }
 
-/// A tick label: plain decimals for moderate magnitudes, exponent form otherwise.
-/// A tick label; a tick within round-off of zero on an axis of width `span` is 0 (the tick
-/// positions are computed in floating point: "-1.39e-17" appeared on slider-velocity plots).
+/// A tick label: plain decimals for moderate magnitudes, exponent form otherwise; a tick within
+/// round-off of zero on an axis of width `span` is 0 (the tick positions are computed in
+/// floating point: "-1.39e-17" appeared on slider-velocity plots).
 fn tick(v: f64, span: f64) -> String {
     let v = if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v };
     if v == 0.0 || (1e-2..1e5).contains(&v.abs()) {
