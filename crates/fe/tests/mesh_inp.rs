@@ -118,3 +118,12 @@ fn data_lines_of_commas_only_are_refused_with_their_line() {
         assert!(e.starts_with("bad.inp:4: ") && e.contains("only commas"), "{block}: {e}");
     }
 }
+
+/// A GENERATE range read from the file is bounded before its ids are collected (a fuzzed
+/// `1, 1000000000000000000` aborted on the allocation).
+#[test]
+fn a_huge_generate_range_is_refused_naming_the_line() {
+    let deck = "*NODE\n1, 0, 0, 0\n*NSET, NSET=ALL, GENERATE\n1, 1000000000000000000\n";
+    let e = inp::parse(deck, "bad.inp").unwrap_err().to_string();
+    assert!(e.contains("bad.inp:4") && e.contains("GENERATE") && e.contains("limit"), "{e}");
+}

@@ -10,6 +10,10 @@ use std::path::{Path, PathBuf};
 use super::{Equation, Material, Mesh, MeshError, Origin, PointElement, RigidCoupling, Solid};
 use crate::element::SolidKind;
 
+/// Most ids one `*NSET`/`*ELSET, GENERATE` line may produce (400 MB of ids): far more than any
+/// mesh this reader is meant for, small enough to allocate.
+const MAX_GENERATED: u64 = 50_000_000;
+
 /// Read a deck from a file (`*INCLUDE` paths are relative to the including file).
 pub fn read(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
     let mut lines = Vec::new();
@@ -637,7 +641,16 @@ impl Parser {
         if s == 0 || b < a {
             return Err(self.syntax(l, "GENERATE needs first <= last and increment >= 1"));
         }
-        Ok((a..=b).step_by(s as usize).collect())
+        // The ids are materialised: a range from the file is bounded before it is collected
+        // (a fuzzed `1, 1000000000000000000` aborted on the allocation).
+        let count = (b - a) / s + 1;
+        if count > MAX_GENERATED {
+            return Err(self.syntax(
+                l,
+                format!("GENERATE of {count} ids exceeds the limit of {MAX_GENERATED} ids per line (check first, last, increment)"),
+            ));
+        }
+        Ok((a..=b).step_by(usize::try_from(s).unwrap_or(usize::MAX)).collect())
     }
 
     fn elements(&mut self, kw: &Line, data: &[&Line], kind: &str, elset: Option<&str>) -> Result<(), MeshError> {
