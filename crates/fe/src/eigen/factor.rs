@@ -78,6 +78,7 @@ impl ShiftedFactor {
             _ => (stiffness, mass.is_none()),
         };
         let symbolic = analyse(a)?;
+        check_memory(symbolic.len_val(), available_memory())?;
         let mut f = ShiftedFactor {
             symbolic: Arc::new(symbolic),
             values: Vec::new(),
@@ -238,6 +239,36 @@ fn analyse(a: SparseColMatRef<'_, usize, f64>) -> Result<SymbolicCholesky<usize>
     })
 }
 
+/// The factor's size is known once the symbolic analysis is done: refuse it, with the estimate,
+/// when it would not fit in the memory available, instead of being killed or aborting on the
+/// allocation. Half the available memory is left for K, M and the eigensolver's blocks.
+fn check_memory(entries: usize, available_bytes: Option<u64>) -> Result<(), EigenError> {
+    let Some(available) = available_bytes else { return Ok(()) };
+    let needed = 8.0 * entries as f64;
+    if needed > 0.5 * available as f64 {
+        return Err(EigenError::FactorTooLarge {
+            entries,
+            needed_gb: needed / 1e9,
+            available_gb: available as f64 / 1e9,
+        });
+    }
+    Ok(())
+}
+
+/// `MemAvailable` of `/proc/meminfo` in bytes (Linux); `None` where it cannot be read.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: u64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb * 1024)
+}
+
 /// `K − σM` on the union of the two patterns (`K` alone without mass).
 fn shifted(
     k: SparseColMatRef<'_, usize, f64>,
@@ -252,4 +283,26 @@ fn shifted(
         None => k.transpose().to_col_major(), // K is symmetric: its transpose is itself
     };
     built.map_err(|e| EigenError::Factorisation(format!("cannot form K - sigma M: {e:?}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{available_memory, check_memory};
+    use crate::eigen::EigenError;
+
+    #[test]
+    fn a_factor_larger_than_half_the_available_memory_is_refused_with_its_size() {
+        // 300 M entries (2.4 GB) with 4 GB available: refused, naming both figures.
+        let e = check_memory(300_000_000, Some(4_000_000_000)).unwrap_err();
+        assert!(matches!(e, EigenError::FactorTooLarge { entries: 300_000_000, .. }));
+        let text = e.to_string();
+        assert!(text.contains("2.4 GB") && text.contains("4.0 GB"), "{text}");
+        // With 24 GB it fits; without a reading nothing is refused.
+        assert!(check_memory(300_000_000, Some(24_000_000_000)).is_ok());
+        assert!(check_memory(usize::MAX / 16, None).is_ok());
+        // This machine reports its available memory (Linux).
+        if cfg!(target_os = "linux") {
+            assert!(available_memory().is_some_and(|b| b > 0));
+        }
+    }
 }

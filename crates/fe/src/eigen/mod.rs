@@ -37,6 +37,8 @@ pub enum EigenError {
     MassIndefinite { what: String },
     #[error("mode {mode} has residual ||K phi - w^2 M phi|| / ||K phi|| = {residual:.2e} above {tolerance:.1e}: the factorisation is inaccurate (check the matrices for near-singular blocks)")]
     Inaccurate { mode: usize, residual: f64, tolerance: f64 },
+    #[error("the sparse factor of K - sigma M would take {needed_gb:.1} GB ({entries} entries, estimated by the symbolic analysis before factorising) and this machine has {available_gb:.1} GB available: use a coarser mesh or a machine with more memory")]
+    FactorTooLarge { entries: usize, needed_gb: f64, available_gb: f64 },
 }
 
 fn dof_text(dof: &Option<usize>) -> String {
