@@ -9,25 +9,11 @@ mod gmsh_binary;
 
 use std::path::{Path, PathBuf};
 
-use fuzz_support::{case, config, debug_has_non_finite, mutate, timed};
-use proptest::test_runner::TestRunner;
+use fuzz_support::{debug_has_non_finite, fuzz};
 use stickslip_fe::mesh::{gmsh, inp, Mesh};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
-
-fn fuzz(target: &str, seeds: &[Vec<u8>], check: impl Fn(usize, &[u8])) {
-    let mut runner = TestRunner::new(config(target));
-    let started = std::time::Instant::now();
-    runner
-        .run(&case(seeds.len()), |(seed, mutations)| {
-            let input = mutate(&seeds[seed], &mutations);
-            timed(target, || check(seed, &input));
-            Ok(())
-        })
-        .unwrap_or_else(|e| panic!("fuzz {target}: {e}"));
-    eprintln!("fuzz {target}: done in {:.1} s", started.elapsed().as_secs_f64());
 }
 
 /// A mesh read from a damaged file is still consistent: finite numbers, elements and sets on

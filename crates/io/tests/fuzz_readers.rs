@@ -7,9 +7,8 @@ mod fuzz_support;
 
 use std::path::{Path, PathBuf};
 
-use fuzz_support::{case, config, debug_has_non_finite, mutate, timed};
+use fuzz_support::{debug_has_non_finite, fuzz};
 use num_complex::Complex64;
-use proptest::test_runner::TestRunner;
 use stickslip_io::matrix::{abaqus, calculix, dmig, mtx, LabelledMatrix};
 use stickslip_io::records;
 use stickslip_io::study::Study;
@@ -32,19 +31,6 @@ fn scratch(target: &str) -> PathBuf {
 
 /// Run `check` on mutations of `seeds`; a panic or a failed assertion fails the test with
 /// the seed and the mutations.
-fn fuzz(target: &str, seeds: &[Vec<u8>], check: impl Fn(usize, &[u8])) {
-    let mut runner = TestRunner::new(config(target));
-    let started = std::time::Instant::now();
-    runner
-        .run(&case(seeds.len()), |(seed, mutations)| {
-            let input = mutate(&seeds[seed], &mutations);
-            timed(target, || check(seed, &input));
-            Ok(())
-        })
-        .unwrap_or_else(|e| panic!("fuzz {target}: {e}"));
-    eprintln!("fuzz {target}: done in {:.1} s", started.elapsed().as_secs_f64());
-}
-
 fn sparse_finite(m: &LabelledMatrix) -> bool {
     let a = m.matrix.as_ref();
     (0..a.ncols()).all(|j| a.val_of_col(j).iter().all(|v| v.is_finite()))

@@ -192,3 +192,18 @@ pub fn debug_has_non_finite(debug: &str) -> bool {
         .split(|c: char| c.is_whitespace() || matches!(c, ',' | '[' | ']' | '(' | ')' | '{' | '}' | ':'))
         .any(|t| matches!(t, "NaN" | "inf" | "-inf"))
 }
+
+/// Run `check` on mutations of `seeds`; a panic or a failed assertion fails the test with
+/// the seed and the mutations.
+pub fn fuzz(target: &str, seeds: &[Vec<u8>], check: impl Fn(usize, &[u8])) {
+    let mut runner = proptest::test_runner::TestRunner::new(config(target));
+    let started = Instant::now();
+    runner
+        .run(&case(seeds.len()), |(seed, mutations)| {
+            let input = mutate(&seeds[seed], &mutations);
+            timed(target, || check(seed, &input));
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("fuzz {target}: {e}"));
+    eprintln!("fuzz {target}: done in {:.1} s", started.elapsed().as_secs_f64());
+}
