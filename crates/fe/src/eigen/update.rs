@@ -74,6 +74,14 @@ impl ShiftInvert for LowRankUpdate<'_> {
         use faer::reborrow::{Reborrow, ReborrowMut};
         self.base.solve_in_place(rhs.rb_mut());
         let y = &self.s_inv * (self.u.transpose() * rhs.rb());
-        rhs += &self.a_inv_u * &y;
+        // rhs += A⁻¹U y, accumulated in place (no n × b temporary).
+        faer::linalg::matmul::matmul(
+            rhs.rb_mut(),
+            faer::Accum::Add,
+            self.a_inv_u.as_ref(),
+            y.as_ref(),
+            1.0,
+            faer::Par::Seq,
+        );
     }
 }
