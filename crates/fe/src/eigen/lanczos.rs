@@ -12,28 +12,17 @@ use faer::{Accum, Mat, MatRef, Par, Side};
 use stickslip_core::model::{symmetric_eigen, Modes};
 
 use super::product::symmetric_product;
-use super::{default_shift, EigenError, EigenOptions, EigenSolution, ShiftInvert, ShiftedFactor};
+use super::{EigenError, EigenOptions, EigenSolution, ShiftInvert};
 
-/// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default).
-pub fn solve(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    opts: &EigenOptions,
-) -> Result<EigenSolution, EigenError> {
-    check_sizes(k, m)?;
-    let shift = opts.shift.unwrap_or_else(|| default_shift(k, m));
-    let factor = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), shift)?;
-    modes_with_factor(k, m, &factor, opts)
-}
-
-fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Result<(), EigenError> {
+pub(super) fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Result<(), EigenError> {
     if k.nrows() != k.ncols() || m.nrows() != m.ncols() || k.nrows() != m.nrows() {
         return Err(EigenError::Size { k_rows: k.nrows(), k_cols: k.ncols(), m_rows: m.nrows(), m_cols: m.ncols() });
     }
     Ok(())
 }
 
-/// As [`solve`], with an existing factorisation of `K − σM` (its shift is used).
+/// The `opts.count` modes of `(K, M)` nearest the shift of `factor`, an existing
+/// factorisation of `K − σM` or an update of one.
 pub fn modes_with_factor(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,

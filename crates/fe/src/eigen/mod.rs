@@ -101,10 +101,11 @@ pub fn solve(
     m: &SparseColMat<usize, f64>,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
+    lanczos::check_sizes(k, m)?;
+    let shift = opts.shift.unwrap_or_else(|| default_shift(k, m));
     check_mass(m, None)?;
-    let solution = lanczos::solve(k, m, opts)?;
-    check_mass(m, Some(&solution))?;
-    Ok(solution)
+    let factor = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), shift)?;
+    modes_with_factor(k, m, &factor, opts)
 }
 
 /// As [`solve`], with an existing factorisation of `K − σM` or an update of one (its shift is
