@@ -79,5 +79,22 @@ fn harmony_softens_and_flattens_with_the_level_while_friction_dissipates() {
     // Section 5.1: the resonance falls and the peak flattens as the level rises.
     assert!(peaks[0].0 > peaks[1].0 && peaks[1].0 > peaks[2].0, "peak frequencies {peaks:?}");
     assert!(peaks[0].1 > 1.5 * peaks[1].1 && peaks[1].1 > peaks[2].1, "peak FRFs {peaks:?}");
+
+    // Figs. 22-23 (the example's [[snapshot]], 238 Hz and 3420 N): the blade top P (11.3)
+    // alternates between following its envelope contact B (21.3) and slipping past it, twice
+    // a period, faster than B moves.
+    let snapshot = std::fs::read_to_string(out.join("snapshot0.csv")).unwrap();
+    let mut lines = snapshot.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let (p, b) = (column(&header, "blade1_11.3_vel_m_s"), column(&header, "blade1_21.3_vel_m_s"));
+    let stuck = rows.iter().filter(|r| r[p] == r[b]).count() as f64 / rows.len() as f64;
+    assert!((0.2..0.8).contains(&stuck), "blade 1 sticks {stuck} of the period at 238 Hz, 3420 N");
+    let slips = rows.windows(2).filter(|w| (w[0][p] == w[0][b]) && (w[1][p] != w[1][b])).count();
+    assert!(slips >= 2, "{slips} slip phases a period");
+    let b_peak = rows.iter().map(|r| r[b].abs()).fold(0.0, f64::max);
+    let relative = rows.iter().map(|r| (r[p] - r[b]).abs()).fold(0.0, f64::max);
+    assert!(relative > b_peak, "slip velocity {relative} m/s, contact velocity {b_peak} m/s");
+    assert!(out.join("snapshot0_blade1.png").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -74,3 +74,111 @@ fn the_blade_example_runs_from_the_mesh_and_softens_as_the_contact_slips() {
     let (f_slip, _) = peak(20.0);
     assert!(f_slip < 330.0, "slipping peak at {f_slip} Hz");
 }
+
+/// CSV columns by name.
+fn columns(path: &std::path::Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    for l in lines {
+        for (c, v) in cols.iter_mut().zip(l.split(',')) {
+            c.push(v.parse().unwrap());
+        }
+    }
+    names.into_iter().zip(cols).collect()
+}
+
+#[test]
+fn a_snapshot_is_the_sweep_point_at_its_frequency_and_its_sides_move_as_eq_33_says() {
+    // A mass M on a spring, a small mass P on its own spring, a Jenkins joint between P and M
+    // (P's side A, M's side B). The band ends at 120 Hz, above the resonance (~80 Hz), where
+    // the response at a level is unique: the snapshot there (reached by a force ramp) and the
+    // sweep's last point (reached along the band) are the same solution.
+    let out = scratch("snapshot");
+    std::fs::create_dir_all(&out).unwrap();
+    let study = out.join("study.toml");
+    std::fs::write(
+        &study,
+        r#"
+[model]
+dofs = ["M", "P"]
+mass = [1.0, 0.1]
+stiffness = [[2.5e5, 0.0], [0.0, 1.0e4]]
+
+[damping]
+alpha = 5.0
+
+[[load]]
+name = "shaker"
+dof = "M"
+
+[[joint]]
+name = "contact"
+law = "jenkins"
+between = ["P", "M"]
+stiffness = 1.0e6
+threshold = 20.0
+
+[excitation]
+levels = [300.0]
+
+[sweep]
+start_hz = 40.0
+end_hz = 120.0
+
+[harmonic_balance]
+harmonics = 9
+samples = 512
+
+[[output]]
+name = "M"
+dof = "M"
+
+[[output]]
+name = "P"
+dof = "P"
+
+[[snapshot]]
+frequency_hz = 120.0
+level = 300.0
+
+[output_options]
+time_data = "all"
+"#,
+    )
+    .unwrap();
+    let status = stickslip().args(["run", "--quiet", "--no-report", "--out"]).arg(&out).arg(&study).status().unwrap();
+    assert!(status.success());
+    let snap = columns(&out.join("snapshot0.csv"));
+    let sweep_end = columns(&out.join("points").join(format!("level0_point{}.csv", last_point(&out))));
+    // Same solution: both converged to the Newton tolerance (1e-10 relative by default) from
+    // different paths; 1e-7 of the amplitude leaves room for the conditioning near slip.
+    for name in ["M_disp_m", "P_disp_m", "contact_force_N"] {
+        let (a, b) = (&snap[name], &sweep_end[name]);
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(diff <= 1e-7 * scale, "{name}: {diff:e} of {scale:e}");
+    }
+    // The joint slips at this point (else the sides would be trivially equal).
+    let slip = &snap["contact_slider_vel_m_s"];
+    assert!(slip.iter().filter(|v| **v != 0.0).count() > slip.len() / 10, "the joint should slip");
+    // Side A (P) = side B (M) + slider velocity (Eq. 33). P's own recovered velocity is
+    // M's + u̇ exactly; the two agree where the joint slips (u̇ is the slider velocity there) to
+    // round-off, and where it sticks differ by the spring's elastic rate, |u̇| ≤ Ω·2F_c/k·N.
+    let (va, vb, vp) = (&snap["contact_P_vel_m_s"], &snap["contact_M_vel_m_s"], &snap["P_vel_m_s"]);
+    assert_eq!(vb, &snap["M_vel_m_s"]);
+    let peak = vp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let elastic = 2.0 * std::f64::consts::PI * 120.0 * 2.0 * 20.0 / 1.0e6 * 9.0;
+    for j in 0..vp.len() {
+        let tol = if slip[j] != 0.0 { 1e-9 * peak } else { elastic };
+        assert!((va[j] - vp[j]).abs() <= tol, "sample {j}: {} vs {}", va[j], vp[j]);
+    }
+    assert!(out.join("snapshot0_contact.png").exists());
+}
+
+/// Index of the last point of the only level (every point has its time data written).
+fn last_point(out: &std::path::Path) -> usize {
+    let rows = std::fs::read_to_string(out.join("frf.csv")).unwrap().lines().count() - 1;
+    rows - 1
+}

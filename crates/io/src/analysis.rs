@@ -6,17 +6,21 @@
 
 use std::path::PathBuf;
 
+use stickslip_core::continuation::Silent;
 use stickslip_core::continuation::{Branch, Observer, Options, Predictor, Rejection, TerminationReason};
-use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings as CoreHbmSettings, SweepError};
+use stickslip_core::hbm::{sweep_frequency, sweep_level, CondensedHbm, HbmSettings as CoreHbmSettings, SweepError};
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
 
-use crate::output::{harmonics_from_coefficients, ElementRecord, LevelResult, OutputRecord, PointRecord};
+use crate::output::{
+    harmonics_from_coefficients, ElementRecord, JointSides, LevelResult, OutputRecord, PointRecord, SnapshotResult,
+};
 use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
 };
 use crate::study::{
-    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod, Study,
+    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod,
+    Snapshot, Study,
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -94,6 +98,70 @@ pub fn run_level<O: Observer + ?Sized>(
         result: LevelResult { level_n: level, points },
         termination: branch.termination,
     })
+}
+
+/// A snapshot that could not be computed.
+#[derive(Debug, thiserror::Error)]
+pub enum SnapshotError {
+    #[error(transparent)]
+    Sweep(#[from] SweepError),
+    #[error("[[snapshot]] at {frequency_hz} Hz, {level} N: the continuation in the force level from {start} N {why}")]
+    NotReached { frequency_hz: f64, level: f64, start: f64, why: String },
+}
+
+/// The periodic response of a `[[snapshot]]`: continued in the force level at its fixed
+/// frequency from a thousandth of the level, where the joints stick, up to the level (the path
+/// of a test's force ramp at a fixed frequency), then post-processed with its time signals.
+///
+/// For each joint placed `between` DOFs A and B where B is an output, the velocities of both
+/// sides: B's is recovered as for any output, A's is B's plus the slider velocity of Eq. 33
+/// (the joint's stiffness is a contact's, its elastic stroke negligible: the paper's Figs.
+/// 22-23 compare a blade top P with its envelope contact B so).
+pub fn run_snapshot(
+    study: &Study,
+    model: &NonlinearModel,
+    excitation: &Excitation,
+    outputs: &[OutputSpec],
+    snapshot: &Snapshot,
+) -> Result<SnapshotResult, SnapshotError> {
+    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
+    let omega = TWO_PI * snapshot.frequency_hz;
+    let start = 1e-3 * snapshot.level;
+    // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
+    let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
+    let branch = sweep_level(&mut hbm, omega, start, snapshot.level, &options, &mut Silent)?;
+    let not_reached = |why: String| SnapshotError::NotReached {
+        frequency_hz: snapshot.frequency_hz,
+        level: snapshot.level,
+        start,
+        why,
+    };
+    let p = match (&branch.termination, branch.points.last()) {
+        (TerminationReason::ReachedEnd, Some(p)) => p,
+        (t, last) => {
+            let reached = last.map_or(start, |p| p.lambda);
+            return Err(not_reached(format!("stopped at {reached} N: {}", describe_termination(t))));
+        }
+    };
+    let selectors: Vec<OutputSelector> =
+        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
+    let result = evaluate_point(&mut hbm, &p.x, omega, snapshot.level, &selectors).map_err(SweepError::from)?;
+    let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let point = record(&result, p.iterations, p.residual_norm / x_norm.max(f64::MIN_POSITIVE), true);
+    let sides = study
+        .joints
+        .iter()
+        .zip(&point.elements)
+        .filter_map(|(j, e)| {
+            let Placement::Between(a, b) = &j.placement else { return None };
+            let o = study.outputs.iter().position(|o| matches!(&o.placement, Placement::Dof(d) if d == b))?;
+            let velocity_b = point.outputs[o].vel.clone();
+            let velocity_a = velocity_b.iter().zip(&e.slider_velocity).map(|(v, w)| v + w).collect();
+            Some(JointSides { joint: j.name.clone(), dof_a: a.clone(), dof_b: b.clone(), velocity_a, velocity_b })
+        })
+        .collect();
+    Ok(SnapshotResult { level_n: snapshot.level, point, sides })
 }
 
 /// A point's results as a record; the time signals only when `time_data`.

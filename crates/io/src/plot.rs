@@ -3,7 +3,9 @@
 //! - [`plot_harmonics`]: amplitude of harmonics 1..N against frequency for one level (the paper's
 //!   Fig. 21 view of where odd harmonics rise);
 //! - [`plot_hysteresis`]: force against displacement of one element over a period;
-//! - [`plot_slider_velocity`]: slider velocity v_P over a period (paper Eq. 33, Fig. 17).
+//! - [`plot_slider_velocity`]: slider velocity v_P over a period (paper Eq. 33, Fig. 17);
+//! - [`plot_joint_sides`]: velocities of a joint's two sides over two periods of a snapshot
+//!   (the paper's Figs. 22-23: blade top P and envelope contact B).
 //!
 //! SVG keeps text as text and needs no font; PNG rasterises labels with a system font found
 //! through fontconfig (on Debian, the package fonts-dejavu-core provides one).
@@ -14,7 +16,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
-use crate::output::{LevelResult, OutputError, PointRecord};
+use crate::output::{JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
 use crate::study::PlotFormat;
 
 const SIZE: (u32, u32) = (1000, 650);
@@ -303,6 +305,31 @@ pub fn plot_slider_velocity(path: &Path, point: &PointRecord, element: &str) -> 
         y_label: "Velocity (m/s)".into(),
         log_y: false,
         curves: vec![Curve { label: element.into(), points }],
+    }
+    .render(path)
+}
+
+/// Velocities (m/s) of the two sides of a joint over two periods (ms) of a snapshot: where they
+/// coincide the joint sticks, where they part it slips (paper Figs. 22-23).
+pub fn plot_joint_sides(path: &Path, snapshot: &SnapshotResult, sides: &JointSides) -> Result<(), OutputError> {
+    let f = snapshot.point.frequency_hz;
+    let two_periods = |v: &[f64]| -> Vec<(f64, f64)> {
+        let n_t = v.len();
+        let dt_ms = 1e3 / (f * n_t as f64);
+        v.iter().chain(v).enumerate().map(|(j, &x)| (dt_ms * j as f64, x)).collect()
+    };
+    Chart {
+        title: format!("{} at {f} Hz, {} N: velocities of its two sides", sides.joint, snapshot.level_n),
+        x_label: "Time (ms)".into(),
+        y_label: "Velocity (m/s)".into(),
+        log_y: false,
+        curves: vec![
+            Curve {
+                label: format!("{} = {} + slip velocity (Eq. 33)", sides.dof_a, sides.dof_b),
+                points: two_periods(&sides.velocity_a),
+            },
+            Curve { label: sides.dof_b.clone(), points: two_periods(&sides.velocity_b) },
+        ],
     }
     .render(path)
 }

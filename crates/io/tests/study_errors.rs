@@ -209,3 +209,16 @@ fn harmonic_balance_sizes_are_bounded() {
     // The largest accepted sizes parse.
     assert!(Study::parse(&hbm("harmonics = 100\nsamples = 16384"), "study.toml").is_ok());
 }
+
+#[test]
+fn a_snapshot_needs_a_positive_frequency_and_level() {
+    let msg = parse_error(&format!("{GOOD}\n[[snapshot]]\nfrequency_hz = -238.0\nlevel = 3420.0\n"));
+    assert!(msg.starts_with("study.toml:29:16: [[snapshot]]: frequency_hz must be > 0 Hz"), "{msg}");
+    assert!(msg.contains("-238"), "{msg}");
+    let msg = parse_error(&format!("{GOOD}\n[[snapshot]]\nfrequency_hz = 238.0\n"));
+    // The error points at the section's header line.
+    assert_eq!(msg, "study.toml:28:1: missing field `level`");
+    let study = Study::parse(&format!("{GOOD}\n[[snapshot]]\nfrequency_hz = 238.0\nlevel = 3420.0\n"), "study.toml");
+    let snapshots = study.unwrap().snapshots;
+    assert_eq!((snapshots.len(), snapshots[0].frequency_hz, snapshots[0].level), (1, 238.0, 3420.0));
+}

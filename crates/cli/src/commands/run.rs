@@ -6,8 +6,8 @@ use anyhow::Context;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
-use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
-use stickslip_io::output::write_results;
+use stickslip_io::analysis::{describe_termination, run_level, run_snapshot, LevelRun};
+use stickslip_io::output::{write_results, write_snapshots};
 use stickslip_io::report::write_report;
 use stickslip_io::study::Study;
 
@@ -87,10 +87,24 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     }
     timings.push(("all levels (wall clock)".into(), elapsed.as_secs_f64()));
     let runs: Vec<LevelRun> = runs.into_iter().map(|(run, _)| run).collect();
+
+    let snapshots_started = Instant::now();
+    // A snapshot that fails does not keep the sweeps' results from being written: it is
+    // reported at the end with the incomplete levels.
+    let (snapshots, failed_snapshots): (Vec<_>, Vec<_>) = study
+        .snapshots
+        .par_iter()
+        .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
+        .partition(Result::is_ok);
+    let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
+    if !snapshots.is_empty() {
+        timings.push(("snapshots".into(), snapshots_started.elapsed().as_secs_f64()));
+    }
     let written = Instant::now();
 
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
-    let files = write_results(&args.out, &levels, study.output_options.plot_format)?;
+    let mut files = write_results(&args.out, &levels, study.output_options.plot_format)?;
+    files.extend(write_snapshots(&args.out, &snapshots, study.output_options.plot_format)?);
     timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
@@ -122,11 +136,13 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .filter(|r| !r.is_complete())
         .map(|r| format!("level {} N {}", r.result.level_n, describe_termination(&r.termination)))
         .collect();
-    if !incomplete.is_empty() {
+    let failed: Vec<String> = failed_snapshots.into_iter().filter_map(Result::err).map(|e| e.to_string()).collect();
+    if !incomplete.is_empty() || !failed.is_empty() {
         anyhow::bail!(
-            "{} level(s) did not cross the band (their points are written):\n  {}",
+            "{} level(s) did not cross the band (their points are written) and {} snapshot(s) failed:\n  {}",
             incomplete.len(),
-            incomplete.join("\n  ")
+            failed.len(),
+            incomplete.iter().chain(&failed).cloned().collect::<Vec<_>>().join("\n  ")
         );
     }
     Ok(())

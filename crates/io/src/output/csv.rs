@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use super::{LevelResult, OutputError, PointRecord};
+use super::{LevelResult, OutputError, PointRecord, SnapshotResult};
 
 /// Column names of `frf.csv` for points shaped like `template` (units in every name).
 pub fn frf_columns(template: &PointRecord) -> Vec<String> {
@@ -135,6 +135,21 @@ pub fn write_frf_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
 /// `<out>_vel_m_s`, per element `<el>_u_m`, `<el>_force_N`, `<el>_slider_vel_m_s`; one row
 /// per sample `θ_j = 2π j / n_t`. Series that were not kept are left out.
 pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> {
+    write_signals(path, p.frequency_hz, point_columns(p))
+}
+
+/// Write a snapshot's time signals: those of [`write_point_csv`], then per joint with both
+/// sides known `<joint>_<A>_vel_m_s` and `<joint>_<B>_vel_m_s`.
+pub fn write_snapshot_csv(path: &Path, s: &SnapshotResult) -> Result<(), OutputError> {
+    let mut columns = point_columns(&s.point);
+    for j in &s.sides {
+        columns.push((format!("{}_{}_vel_m_s", j.joint, j.dof_a), &j.velocity_a));
+        columns.push((format!("{}_{}_vel_m_s", j.joint, j.dof_b), &j.velocity_b));
+    }
+    write_signals(path, s.point.frequency_hz, columns)
+}
+
+fn point_columns(p: &PointRecord) -> Vec<(String, &[f64])> {
     let mut columns: Vec<(String, &[f64])> = Vec::new();
     for o in &p.outputs {
         columns.push((format!("{}_disp_m", o.name), &o.disp));
@@ -145,6 +160,11 @@ pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> 
         columns.push((format!("{}_force_N", e.name), &e.loop_force));
         columns.push((format!("{}_slider_vel_m_s", e.name), &e.slider_velocity));
     }
+    columns
+}
+
+/// Signals over one period at `frequency_hz`, one column each (empty ones left out).
+fn write_signals(path: &Path, frequency_hz: f64, mut columns: Vec<(String, &[f64])>) -> Result<(), OutputError> {
     columns.retain(|(_, v)| !v.is_empty());
     let n_t = columns.iter().map(|(_, v)| v.len()).max().unwrap_or(0);
     if let Some((name, v)) = columns.iter().find(|(_, v)| v.len() != n_t) {
@@ -159,13 +179,13 @@ pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> 
         text.push_str(name);
     }
     text.push('\n');
-    let omega = 2.0 * std::f64::consts::PI * p.frequency_hz;
+    let omega = 2.0 * std::f64::consts::PI * frequency_hz;
     if n_t > 0 && !(omega.is_finite() && omega > 0.0) {
         return Err(OutputError::NotFinite {
             path: path.to_path_buf(),
             quantity: "the period (time_s column)".into(),
-            location: format!("the point at {} Hz", p.frequency_hz),
-            value: 1.0 / p.frequency_hz,
+            location: format!("the point at {frequency_hz} Hz"),
+            value: 1.0 / frequency_hz,
         });
     }
     for (name, v) in &columns {
@@ -173,7 +193,7 @@ pub fn write_point_csv(path: &Path, p: &PointRecord) -> Result<(), OutputError> 
             return Err(OutputError::NotFinite {
                 path: path.to_path_buf(),
                 quantity: format!("series `{name}`"),
-                location: format!("sample {j} of the point at {} Hz", p.frequency_hz),
+                location: format!("sample {j} of the point at {frequency_hz} Hz"),
                 value: v[j],
             });
         }

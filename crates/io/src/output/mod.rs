@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::study::PlotFormat;
 
-pub use csv::{frf_columns, write_frf_csv, write_point_csv, write_time_data};
+pub use csv::{frf_columns, write_frf_csv, write_point_csv, write_snapshot_csv, write_time_data};
 pub use npz::write_frf_npz;
 
 /// All converged points of one force level.
@@ -72,6 +72,29 @@ pub struct ElementRecord {
     pub slider_velocity: Vec<f64>,
 }
 
+/// The periodic response at one fixed frequency and force level (a `[[snapshot]]`), with its
+/// time signals.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SnapshotResult {
+    /// Force level (N).
+    pub level_n: f64,
+    pub point: PointRecord,
+    pub sides: Vec<JointSides>,
+}
+
+/// The velocities over one period of the two sides of a joint placed between DOFs A and B
+/// (paper Figs. 22-23: the blade top P and its envelope contact B).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct JointSides {
+    pub joint: String,
+    pub dof_a: String,
+    pub dof_b: String,
+    /// Velocity of A: B's plus the slider velocity (Eq. 33), m/s.
+    pub velocity_a: Vec<f64>,
+    /// Velocity of B (m/s).
+    pub velocity_b: Vec<f64>,
+}
+
 impl PointRecord {
     /// Does this point carry time data?
     pub fn has_time_data(&self) -> bool {
@@ -106,6 +129,28 @@ pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat
     write_time_data(dir, levels)?;
     files.extend(crate::plot::plot_frfs(dir, levels, plot_format)?);
     files.extend(crate::plot::plot_level_details(dir, levels, plot_format)?);
+    Ok(files)
+}
+
+/// Write each snapshot's time signals, `snapshot<i>.csv` (i from 0, in the study's order), and
+/// per joint with both sides known the plot of their velocities, `snapshot<i>_<joint>.<ext>`.
+/// Returns the files written.
+pub fn write_snapshots(
+    dir: &Path,
+    snapshots: &[SnapshotResult],
+    plot_format: PlotFormat,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mut files = Vec::new();
+    for (i, s) in snapshots.iter().enumerate() {
+        let csv = dir.join(format!("snapshot{i}.csv"));
+        write_snapshot_csv(&csv, s)?;
+        files.push(csv);
+        for sides in &s.sides {
+            let path = dir.join(format!("snapshot{i}_{}.{}", sides.joint, plot_format.extension()));
+            crate::plot::plot_joint_sides(&path, s, sides)?;
+            files.push(path);
+        }
+    }
     Ok(files)
 }
 

@@ -39,6 +39,8 @@ pub struct Study {
     /// Requested outputs; empty means "every DOF of the model" (allowed for small models only).
     pub outputs: Vec<OutputSelector>,
     pub output_options: OutputOptions,
+    /// Periodic responses asked at fixed (frequency, level) pairs, besides the sweeps.
+    pub snapshots: Vec<Snapshot>,
 }
 
 /// Line and column (both from 1) of a key in the study file.
@@ -256,6 +258,16 @@ pub struct ContinuationSettings {
 pub struct OutputSelector {
     pub name: String,
     pub placement: Placement,
+    pub at: Location,
+}
+
+/// `[[snapshot]]`: the periodic response at one frequency and force level, with its time
+/// signals (the paper's Figs. 22-23: velocities of a blade top and its contact at 238 Hz).
+#[derive(Clone, Debug)]
+pub struct Snapshot {
+    pub frequency_hz: f64,
+    /// Force level (N).
+    pub level: f64,
     pub at: Location,
 }
 

@@ -25,6 +25,8 @@ pub(crate) struct RawStudy {
     #[serde(default)]
     pub output: Vec<S<RawOutput>>,
     pub output_options: Option<S<RawOutputOptions>>,
+    #[serde(default)]
+    pub snapshot: Vec<S<RawSnapshot>>,
 }
 
 /// A matrix written inline: a list of rows, or a list of diagonal values.
@@ -160,6 +162,14 @@ pub(crate) struct RawOutput {
     pub name: S<String>,
     pub dof: Option<S<String>>,
     pub vector: Option<S<Vec<f64>>>,
+}
+
+/// `[[snapshot]]`: one periodic response at a fixed frequency and level.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSnapshot {
+    pub frequency_hz: S<f64>,
+    pub level: S<f64>,
 }
 
 /// `time_data = "none" | "all"` or an integer k (every k-th point).

@@ -128,6 +128,16 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     }
     unique_names(&src, raw.output.iter().map(|o| &o.get_ref().name), "[[output]]")?;
     let output_options = output_options(&src, raw.output_options.as_ref())?;
+    let mut snapshots = Vec::with_capacity(raw.snapshot.len());
+    for s in &raw.snapshot {
+        let r = s.get_ref();
+        const CTX: &str = "[[snapshot]]";
+        snapshots.push(Snapshot {
+            frequency_hz: positive(&src, &r.frequency_hz, CTX, "frequency_hz", " Hz")?,
+            level: positive(&src, &r.level, CTX, "level", " N")?,
+            at: src.location(&s.span()),
+        });
+    }
 
     Ok(Study {
         path: file.to_path_buf(),
@@ -142,6 +152,7 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         continuation,
         outputs,
         output_options,
+        snapshots,
     })
 }
 
