@@ -23,6 +23,7 @@ use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine as _;
 
 use crate::output::LevelResult;
+pub use crate::output::Peak;
 
 /// The file name of the report in a run's output directory.
 pub const REPORT_FILE: &str = "report.html";
@@ -114,25 +115,16 @@ pub struct LevelSummary {
     pub ending: String,
 }
 
-/// The largest FRF amplitude of one output at one level.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Peak {
-    /// Force level (N).
-    pub level_n: f64,
-    pub output: String,
-    /// Frequency of the largest amplitude (Hz).
-    pub frequency_hz: f64,
-    /// |X₁| / F there (m/N).
-    pub disp_frf: f64,
-    /// Ω² |X₁| / F there (m s⁻² / N).
-    pub accel_frf: f64,
-}
-
-/// Per level and output, the point of largest displacement FRF |X₁|/F (points whose FRF is not
-/// a finite number are skipped; a level or output without any gives no entry).
+/// Per level and output, the peak of the displacement FRF |X₁|/F: the located ones of a level
+/// that has them ([`LevelResult::peaks`]), else the point of largest value (points whose FRF is
+/// not a finite number are skipped; a level or output without any gives no entry).
 pub fn peaks(levels: &[LevelResult]) -> Vec<Peak> {
     let mut peaks = Vec::new();
     for level in levels {
+        if !level.peaks.is_empty() {
+            peaks.extend(level.peaks.iter().cloned());
+            continue;
+        }
         let mut names: Vec<&str> = Vec::new();
         for p in &level.points {
             for o in &p.outputs {
@@ -155,6 +147,7 @@ pub fn peaks(levels: &[LevelResult]) -> Vec<Peak> {
                     frequency_hz: p.frequency_hz,
                     disp_frf: o.disp_frf,
                     accel_frf: o.accel_frf,
+                    located: false,
                 });
             }
         }
@@ -610,8 +603,9 @@ mod tests {
                     point(238.25, &[("mass", 4.5e-5), ("a<b>&c", 2e-7)]),
                     point(260.0, &[("mass", f64::NAN), ("a<b>&c", 9.75e-6)]),
                 ],
+                peaks: vec![],
             },
-            LevelResult { level_n: 1000.0, points: vec![] },
+            LevelResult { level_n: 1000.0, points: vec![], peaks: vec![] },
         ];
         ReportData {
             title: "study <1> & \"two\".toml".into(),

@@ -53,8 +53,16 @@ fn point(f: f64, seed: usize, n_t: usize) -> PointRecord {
 
 fn levels(n_t: usize) -> Vec<LevelResult> {
     vec![
-        LevelResult { level_n: 100.0, points: (0..5).map(|i| point(150.0 + i as f64 * 0.1, i, n_t)).collect() },
-        LevelResult { level_n: 1000.0, points: (0..3).map(|i| point(350.0 - i as f64 / 3.0, 40 + i, 0)).collect() },
+        LevelResult {
+            level_n: 100.0,
+            points: (0..5).map(|i| point(150.0 + i as f64 * 0.1, i, n_t)).collect(),
+            peaks: vec![],
+        },
+        LevelResult {
+            level_n: 1000.0,
+            points: (0..3).map(|i| point(350.0 - i as f64 / 3.0, 40 + i, 0)).collect(),
+            peaks: vec![],
+        },
     ]
 }
 
@@ -182,9 +190,13 @@ fn write_results_writes_table_arrays_time_data_and_plots() {
     let dir = scratch_dir("all").join("run");
     let files = write_results(&dir, &levels(64), PlotFormat::Svg).unwrap();
     let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
-    assert_eq!(names[..4], ["frf.csv", "frf.npz", "frf_mass.svg", "frf_slider-P.svg"]);
+    assert_eq!(names[..5], ["frf.csv", "frf.npz", "peaks.csv", "frf_mass.svg", "frf_slider-P.svg"]);
     // Harmonics of 2 outputs at 2 levels; loop and slider velocity where time data exist.
-    assert_eq!(names.len(), 4 + 2 * 2 + 2);
+    assert_eq!(names.len(), 5 + 2 * 2 + 2);
+    // No located peaks given: the largest sampled point per level and output, marked 0.
+    let peaks = std::fs::read_to_string(dir.join("peaks.csv")).unwrap();
+    assert_eq!(peaks.lines().count(), 1 + 2 * 2);
+    assert!(peaks.lines().skip(1).all(|l| l.ends_with(",0")), "{peaks}");
     assert!(names.contains(&"loop_level0_joint_1.svg".to_string()));
     assert!(files.iter().all(|f| std::fs::metadata(f).unwrap().len() > 0));
     // 5 points of level 0 carry time data (level 1 was built without).

@@ -71,7 +71,8 @@ fn writers_refuse_non_finite_values_naming_the_quantity_and_where() {
         }],
         elements: vec![],
     };
-    let levels = vec![LevelResult { level_n: 10.0, points: vec![point(5.0, 1e-6), point(6.0, f64::NAN)] }];
+    let levels =
+        vec![LevelResult { level_n: 10.0, points: vec![point(5.0, 1e-6), point(6.0, f64::NAN)], peaks: vec![] }];
     for (name, result) in [
         ("frf.csv", write_frf_csv(&dir.join("frf.csv"), &levels)),
         ("frf.npz", write_frf_npz(&dir.join("frf.npz"), &levels)),

@@ -106,9 +106,11 @@
 //! # Ok::<(), stickslip_core::continuation::ContinuationError>(())
 //! ```
 
+mod extremum;
 mod linear;
 mod run;
 
+pub use extremum::{maximise_along, Extremum};
 pub use run::continue_branch;
 
 use faer::MatMut;

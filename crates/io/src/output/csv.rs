@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
-use super::{LevelResult, OutputError, PointRecord, SnapshotResult};
+use super::{LevelResult, OutputError, Peak, PointRecord, SnapshotResult};
 
 /// Column names of `frf.csv` for points shaped like `template` (units in every name).
 pub fn frf_columns(template: &PointRecord) -> Vec<String> {
@@ -225,4 +225,36 @@ pub fn write_time_data(dir: &Path, levels: &[LevelResult]) -> Result<usize, Outp
         }
     }
     Ok(written)
+}
+
+/// Write `peaks.csv`: per level and output, the FRF peak (`level_N,output,frequency_Hz,
+/// disp_frf_m_per_N,accel_frf_m_s2_per_N,located`; `located` is 1 for a peak located between
+/// the sampled points, 0 for the largest sampled point, at an end of the band).
+pub fn write_peaks_csv(path: &Path, peaks: &[Peak]) -> Result<(), OutputError> {
+    let mut text = String::from("level_N,output,frequency_Hz,disp_frf_m_per_N,accel_frf_m_s2_per_N,located\n");
+    for p in peaks {
+        for (quantity, value) in
+            [("frequency", p.frequency_hz), ("displacement FRF", p.disp_frf), ("acceleration FRF", p.accel_frf)]
+        {
+            if !value.is_finite() {
+                return Err(OutputError::NotFinite {
+                    path: path.to_path_buf(),
+                    quantity: format!("the peak {quantity}"),
+                    location: format!("output {} at {} N", p.output, p.level_n),
+                    value,
+                });
+            }
+        }
+        let _ = writeln!(
+            text,
+            "{:e},{},{:e},{:e},{:e},{}",
+            p.level_n,
+            p.output,
+            p.frequency_hz,
+            p.disp_frf,
+            p.accel_frf,
+            u8::from(p.located)
+        );
+    }
+    write_file(path, &text)
 }

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::study::PlotFormat;
 
-pub use csv::{frf_columns, write_frf_csv, write_point_csv, write_snapshot_csv, write_time_data};
+pub use csv::{frf_columns, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv, write_time_data};
 pub use npz::write_frf_npz;
 
 /// All converged points of one force level.
@@ -22,6 +22,25 @@ pub struct LevelResult {
     /// Excitation level (N).
     pub level_n: f64,
     pub points: Vec<PointRecord>,
+    /// Per output, the resonance peak located along the branch (empty when not located).
+    pub peaks: Vec<Peak>,
+}
+
+/// The largest displacement FRF of one output at one level.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Peak {
+    /// Force level (N).
+    pub level_n: f64,
+    pub output: String,
+    /// Frequency of the largest amplitude (Hz).
+    pub frequency_hz: f64,
+    /// |X₁| / F there (m/N).
+    pub disp_frf: f64,
+    /// Ω² |X₁| / F there (m s⁻² / N).
+    pub accel_frf: f64,
+    /// Located between the sampled points (`stickslip_core::continuation::maximise_along`),
+    /// or, when false, the largest sampled point (a peak at an end of the band).
+    pub located: bool,
 }
 
 /// One converged point of a branch.
@@ -116,7 +135,8 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`, the
+/// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`,
+/// `peaks.csv` (see [`write_peaks_csv`]), the
 /// time data of the points that carry it (`points/`), and one FRF plot per output
 /// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`]. Returns the
 /// paths of the FRF table, the NPZ file and the plots.
@@ -125,7 +145,9 @@ pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
     write_frf_csv(&csv, levels)?;
     write_frf_npz(&npz, levels)?;
-    let mut files = vec![csv, npz];
+    let peaks = dir.join("peaks.csv");
+    write_peaks_csv(&peaks, &crate::report::peaks(levels))?;
+    let mut files = vec![csv, npz, peaks];
     write_time_data(dir, levels)?;
     files.extend(crate::plot::plot_frfs(dir, levels, plot_format)?);
     files.extend(crate::plot::plot_level_details(dir, levels, plot_format)?);

@@ -1,0 +1,261 @@
+//! The largest value of a quantity along a branch, located between the points the continuation
+//! sampled: a resonance peak, whatever the point density.
+//!
+//! The three points around the largest sampled value bracket the maximum. Between the outer
+//! two, the branch is parametrised by `s ∈ [0, 1]` along their chord `c` in scaled variables
+//! (as the continuation's, Eq. 31): the point at `s` solves
+//!
+//! ```text
+//! R(x, λ) = 0,      cᵀ (z − z_before − s c) = 0
+//! ```
+//!
+//! the corrector of Eq. 32 on the hyperplane orthogonal to the chord, so that a fold inside the
+//! bracket (a hardening peak) is parametrised as well as a plain peak. The quantity is scanned
+//! at a few values of `s` (a friction peak has several local maxima, see below), then maximised
+//! around the best by Brent's method (golden section with parabolic steps, Brent 1973, ch. 5). It is written here rather than taken from `argmin`,
+//! whose solver framework is far more than one bounded scalar search needs.
+
+use super::linear::Workspace;
+use super::{Point, Problem, ProblemError};
+
+/// The located maximum.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Extremum {
+    pub x: Vec<f64>,
+    pub lambda: f64,
+    /// The quantity there.
+    pub value: f64,
+    /// Points solved on the branch to locate it.
+    pub solves: usize,
+}
+
+/// 1 − 1/φ: the golden-section step.
+const GOLDEN: f64 = 0.381_966_011_250_105_1;
+/// Newton iterations allowed for one point of the bracket.
+const MAX_ITERATIONS: usize = 30;
+/// Points scanned around the envelope's vertex before the local refinement, and the half-width
+/// of that window on the bracket's chord (1 = the whole bracket, two continuation steps): the
+/// scan's spacing, 0.3/64 ≈ 0.005 of the bracket, is below the width of one arc of a friction
+/// peak at the default steps (see below).
+const SCAN: usize = 64;
+const WINDOW: f64 = 0.15;
+
+/// Locate the maximum of `quantity(problem, x, λ)` along the branch of `problem` between
+/// `before` and `after`, given `middle`, a converged point between them where the quantity is
+/// at least as large as at both. `tolerance` is on `s` (1 = the bracket's chord); the point
+/// found is converged to round-off (Newton until the scaled update stops decreasing).
+pub fn maximise_along<P: Problem>(
+    problem: &mut P,
+    [before, middle, after]: [&Point; 3],
+    tolerance: f64,
+    mut quantity: impl FnMut(&mut P, &[f64], f64) -> Result<f64, ProblemError>,
+) -> Result<Extremum, ProblemError> {
+    let n = problem.dimension();
+    // Scaled variables z = [x/s_x, λ/s_λ]: the chord has comparable x and λ parts.
+    let x_scale = [before, middle, after]
+        .iter()
+        .map(|p| p.x.iter().map(|v| v * v).sum::<f64>().sqrt())
+        .fold(f64::MIN_POSITIVE, f64::max);
+    let lambda_scale = (after.lambda - before.lambda).abs().max(1e-12 * middle.lambda.abs()).max(f64::MIN_POSITIVE);
+    let scaled = |p: &Point| -> Vec<f64> {
+        p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
+    };
+    let (z0, zm, z1) = (scaled(before), scaled(middle), scaled(after));
+    let chord: Vec<f64> = z1.iter().zip(&z0).map(|(b, a)| b - a).collect();
+    let chord2: f64 = chord.iter().map(|c| c * c).sum();
+    let sm = chord.iter().zip(zm.iter().zip(&z0)).map(|(c, (m, a))| c * (m - a)).sum::<f64>() / chord2;
+    if !(sm > 0.0 && sm < 1.0) {
+        return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
+    }
+
+    let mut workspace = Workspace::new(n);
+    let mut z = vec![0.0; n + 1];
+    let mut x = vec![0.0; n];
+    let mut solves = 0;
+    // The point at s: from the last point solved if it is near (the scan's neighbours, one or
+    // two Newton iterations), else from the parabola through the three points.
+    let mut last: Option<(f64, Vec<f64>)> = None;
+    let mut solve = |problem: &mut P, s: f64, z: &mut Vec<f64>| -> Result<bool, ProblemError> {
+        solves += 1;
+        match &last {
+            Some((s_last, z_last)) if (s - s_last).abs() <= 0.02 => {
+                for i in 0..=n {
+                    z[i] = z_last[i] + (s - s_last) * chord[i];
+                }
+            }
+            _ => {
+                let (l0, lm, l1) =
+                    ((s - sm) * (s - 1.0) / sm, s * (s - 1.0) / (sm * (sm - 1.0)), s * (s - sm) / (1.0 - sm));
+                for i in 0..=n {
+                    z[i] = l0 * z0[i] + lm * zm[i] + l1 * z1[i];
+                }
+            }
+        }
+        let target: Vec<f64> = z0.iter().zip(&chord).map(|(a, c)| a + s * c).collect();
+        let mut last_step = f64::INFINITY;
+        // Residuals relative to their change across the bracket, ‖∂R/∂λ‖ s_λ (set at the first
+        // evaluation), so that the rows of the bordered matrix are of one magnitude.
+        let mut residual_scale = 0.0;
+        for _ in 0..MAX_ITERATIONS {
+            for (xi, zi) in x.iter_mut().zip(z.iter()) {
+                *xi = zi * x_scale;
+            }
+            let lambda = z[n] * lambda_scale;
+            let (residual, jx, jl) = workspace.evaluation_buffers();
+            problem.evaluate(&x, lambda, residual, Some((jx, jl)))?;
+            if residual_scale == 0.0 {
+                residual_scale = workspace.dr_dlambda.iter().map(|v| v * v).sum::<f64>().sqrt() * lambda_scale;
+                if !(residual_scale.is_finite() && residual_scale > 0.0) {
+                    residual_scale = 1.0;
+                }
+            }
+            let constraint: f64 = chord.iter().zip(z.iter().zip(&target)).map(|(c, (a, b))| c * (a - b)).sum();
+            for i in 0..n {
+                workspace.rhs[i] = -workspace.residual[i] / residual_scale;
+            }
+            workspace.rhs[n] = -constraint;
+            if !workspace.residual.iter().all(|r| r.is_finite())
+                || !workspace.solve_bordered(x_scale, lambda_scale, residual_scale, &chord)
+            {
+                return Ok(false);
+            }
+            let step = workspace.rhs.iter().map(|d| d * d).sum::<f64>().sqrt();
+            for (zi, d) in z.iter_mut().zip(&workspace.rhs) {
+                *zi += d;
+            }
+            // Converged to round-off: the update is negligible, or small and no longer shrinking.
+            if step <= 1e-14 * (1.0 + z.iter().map(|v| v * v).sum::<f64>().sqrt()) || (step < 1e-8 && step >= last_step)
+            {
+                last = Some((s, z.clone()));
+                return Ok(true);
+            }
+            last_step = step;
+        }
+        Ok(false)
+    };
+    // The quantity at s; the best point so far is kept.
+    let mut best = (f64::NEG_INFINITY, zm.clone());
+    let mut value_at = |problem: &mut P, s: f64| -> Result<f64, ProblemError> {
+        if !solve(problem, s, &mut z)? {
+            // A point that cannot be solved is not the maximum.
+            return Ok(f64::NEG_INFINITY);
+        }
+        let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
+        let value = quantity(problem, &x, z[n] * lambda_scale)?;
+        if value > best.0 {
+            best = (value, z.clone());
+        }
+        Ok(value)
+    };
+
+    // A friction peak is a chain of smooth arcs joined at corners: the slip instants move in
+    // steps of one time sample as the phase turns through the resonance, every few hundredths
+    // of a hertz for 300 samples. Each arc has its own local maximum, within ~1e-5 of the
+    // others near the top. The three sampled points place the envelope's vertex (a parabola
+    // through them); a dense scan around it finds the highest arc, Brent's method then its
+    // maximum.
+    let (f0, fm, f1) = (value_at(problem, 0.0)?, value_at(problem, sm)?, value_at(problem, 1.0)?);
+    let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
+    let denominator = sm * d0 - (sm - 1.0) * d1;
+    let vertex = if denominator != 0.0 && denominator.is_finite() {
+        (sm - 0.5 * (sm * d0 * sm - (sm - 1.0) * d1 * (sm - 1.0)) / denominator).clamp(0.0, 1.0)
+    } else {
+        sm
+    };
+    let (lo, hi) = ((vertex - WINDOW).max(0.0), (vertex + WINDOW).min(1.0));
+    let mut samples: Vec<(f64, f64)> = vec![(sm, fm)];
+    for k in 0..=SCAN {
+        let s = lo + (hi - lo) * k as f64 / SCAN as f64;
+        if s > 0.0 && s < 1.0 {
+            samples.push((s, value_at(problem, s)?));
+        }
+    }
+    samples.extend([(0.0, f64::NEG_INFINITY), (1.0, f64::NEG_INFINITY)]);
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let j = (1..samples.len() - 1).max_by(|&a, &b| samples[a].1.total_cmp(&samples[b].1)).expect("interior samples");
+    if samples[j].1.is_finite() {
+        brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| value_at(problem, s))?;
+    }
+    let (value, best_z) = best;
+    if !value.is_finite() {
+        return Err(ProblemError::new("no point of the bracket could be solved"));
+    }
+    Ok(Extremum {
+        x: best_z[..n].iter().map(|v| v * x_scale).collect(),
+        lambda: best_z[n] * lambda_scale,
+        value,
+        solves,
+    })
+}
+
+/// Brent's method (golden section with parabolic steps) for a maximum of `f` on `[a, b]`, from
+/// an interior point `(x, f(x))` at least as high as the ends; to `tolerance` on the abscissa.
+/// Returns the best abscissa and value.
+fn brent_maximum(
+    mut a: f64,
+    mut b: f64,
+    (x0, f0): (f64, f64),
+    tolerance: f64,
+    mut f: impl FnMut(f64) -> Result<f64, ProblemError>,
+) -> Result<(f64, f64), ProblemError> {
+    // Minimise −f, as Brent writes it.
+    let (mut xs, mut w, mut v) = (x0, x0, x0);
+    let (mut fx, mut fw, mut fv) = (-f0, -f0, -f0);
+    let (mut d, mut e) = (0.0f64, 0.0f64);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        let tol1 = tolerance;
+        let tol2 = 2.0 * tol1;
+        if (xs - m).abs() <= tol2 - 0.5 * (b - a) {
+            break;
+        }
+        let mut golden = true;
+        if e.abs() > tol1 {
+            let r = (xs - w) * (fx - fv);
+            let mut q = (xs - v) * (fx - fw);
+            let mut p = (xs - v) * q - (xs - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            } else {
+                q = -q;
+            }
+            let previous = e;
+            e = d;
+            if p.abs() < (0.5 * q * previous).abs() && p > q * (a - xs) && p < q * (b - xs) {
+                d = p / q;
+                let u = xs + d;
+                if u - a < tol2 || b - u < tol2 {
+                    d = tol1.copysign(m - xs);
+                }
+                golden = false;
+            }
+        }
+        if golden {
+            e = if xs >= m { a - xs } else { b - xs };
+            d = GOLDEN * e;
+        }
+        let u = if d.abs() >= tol1 { xs + d } else { xs + tol1.copysign(d) };
+        let fu = -f(u)?;
+        if fu <= fx {
+            if u >= xs {
+                a = xs;
+            } else {
+                b = xs;
+            }
+            (v, fv, w, fw, xs, fx) = (w, fw, xs, fx, u, fu);
+        } else {
+            if u < xs {
+                a = u;
+            } else {
+                b = u;
+            }
+            if fu <= fw || w == xs {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == xs || v == w {
+                (v, fv) = (u, fu);
+            }
+        }
+    }
+    Ok((xs, -fx))
+}

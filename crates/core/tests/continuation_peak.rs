@@ -1,0 +1,100 @@
+//! The maximum of a quantity along a branch, located between the sampled points
+//! (`continuation::maximise_along`), against closed forms: the resonance peak of a linear
+//! oscillator, and the peak of a hardening Duffing oscillator, which lies next to a fold.
+use faer::MatMut;
+use stickslip_core::continuation::{
+    continue_branch, maximise_along, Options, Point, Problem, ProblemError, Silent, TerminationReason,
+};
+
+/// One-harmonic balance of `m ẍ + c ẋ + k x + k3 x³ = F cos Ωt`, `x = a cos Ωt + b sin Ωt`,
+/// λ = Ω: `(k − mΩ² + ¾ k3 A²) a + cΩ b = F`, `(k − mΩ² + ¾ k3 A²) b − cΩ a = 0`.
+struct Oscillator {
+    m: f64,
+    c: f64,
+    k: f64,
+    k3: f64,
+    f: f64,
+}
+
+impl Problem for Oscillator {
+    fn dimension(&self) -> usize {
+        2
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        w: f64,
+        r: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        let (a, b) = (x[0], x[1]);
+        let kappa = self.k - self.m * w * w + 0.75 * self.k3 * (a * a + b * b);
+        r[0] = kappa * a + self.c * w * b - self.f;
+        r[1] = kappa * b - self.c * w * a;
+        if let Some((mut j, dl)) = jacobian {
+            let g = 1.5 * self.k3;
+            j[(0, 0)] = kappa + g * a * a;
+            j[(0, 1)] = g * a * b + self.c * w;
+            j[(1, 0)] = g * a * b - self.c * w;
+            j[(1, 1)] = kappa + g * b * b;
+            dl[0] = -2.0 * self.m * w * a + self.c * b;
+            dl[1] = -2.0 * self.m * w * b - self.c * a;
+        }
+        Ok(())
+    }
+}
+
+fn amplitude(x: &[f64]) -> f64 {
+    x[0].hypot(x[1])
+}
+
+/// The branch from `w0` to `w1` at default steps, and the maximum located around its largest
+/// sampled amplitude.
+fn located_peak(p: &mut Oscillator, w0: f64, w1: f64) -> (Point, stickslip_core::continuation::Extremum) {
+    let guess = [p.f / (p.k - p.m * w0 * w0), 0.0];
+    let branch = continue_branch(p, &guess, w0, w1, &Options::default(), &mut Silent).unwrap();
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    let pts = &branch.points;
+    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    assert!(i > 0 && i + 1 < pts.len());
+    let found = maximise_along(p, [&pts[i - 1], &pts[i], &pts[i + 1]], 1e-9, |_, x, _| Ok(amplitude(x))).unwrap();
+    (pts[i].clone(), found)
+}
+
+#[test]
+fn the_peak_of_a_linear_oscillator_is_located_at_its_closed_form() {
+    // ζ = 2 %: the displacement peak is at ω_n √(1 − 2ζ²), of height F / (2ζ k √(1 − ζ²)).
+    let (m, wn, zeta, f) = (2.0, 2.0 * std::f64::consts::PI * 100.0, 0.02, 10.0);
+    let k = m * wn * wn;
+    let mut p = Oscillator { m, c: 2.0 * zeta * m * wn, k, k3: 0.0, f };
+    let (sampled, found) = located_peak(&mut p, 0.5 * wn, 1.5 * wn);
+    let (w_peak, a_peak) = (wn * (1.0 - 2.0 * zeta * zeta).sqrt(), f / (2.0 * zeta * k * (1.0 - zeta * zeta).sqrt()));
+    // The sampled maximum is off by the point density, the located one by round-off: a peak is
+    // flat (A − A_peak ∝ (Ω − Ω_peak)²), so 1e-9 on s gives ~1e-9 of the bracket in Ω and
+    // 1e-13 in A.
+    assert!((sampled.lambda - w_peak).abs() > 1e-5 * w_peak, "the default steps happen to hit the peak");
+    assert!((found.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", found.lambda);
+    assert!((found.value - a_peak).abs() < 1e-12 * a_peak, "{} vs {a_peak}", found.value);
+    assert!(found.solves < 40, "{} solves", found.solves);
+}
+
+#[test]
+fn the_peak_of_a_hardening_duffing_oscillator_next_to_its_fold_is_located() {
+    // Along the branch the amplitude is largest where the two frequencies of one amplitude
+    // merge: with κ = k + ¾ k3 A², A² = 4m²F² / (4mκc² − c⁴) (discriminant of the quadratic in
+    // Ω² of F² = A²[(κ − mΩ²)² + c²Ω²]), at mΩ² = κ − c²/(2m). Solved by fixed point.
+    let (m, k, c, k3, f) = (1.0, 1.0e4, 2.0, 5.0e7, 2.0);
+    let mut p = Oscillator { m, c, k, k3, f };
+    let mut a2 = 1e-4;
+    for _ in 0..200 {
+        let kappa = k + 0.75 * k3 * a2;
+        a2 = 4.0 * m * m * f * f / (4.0 * m * kappa * c * c - c.powi(4));
+    }
+    let kappa = k + 0.75 * k3 * a2;
+    let w_peak = ((kappa - c * c / (2.0 * m)) / m).sqrt();
+    let (_, found) = located_peak(&mut p, 50.0, 400.0);
+    // The peak is the branch's point of horizontal tangent in A, a hair before the fold: the
+    // bracket's hyperplanes cross the branch there transversally.
+    assert!((found.value - a2.sqrt()).abs() < 1e-10 * a2.sqrt(), "{} vs {}", found.value, a2.sqrt());
+    assert!((found.lambda - w_peak).abs() < 1e-6 * w_peak, "{} vs {w_peak}", found.lambda);
+}
