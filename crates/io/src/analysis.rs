@@ -119,16 +119,21 @@ pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool
                 }
             })
             .collect(),
+        // One record per direction: `joint` for a one-direction element, `joint.1`, `joint.2`,
+        // ... otherwise (as the time integrator names its records), each with its own energy.
         elements: p
             .elements
             .iter()
-            .map(|e| ElementRecord {
-                name: e.name.clone(),
-                energy_j: e.energy_per_cycle,
-                stick_fraction: e.stick_fraction,
-                loop_u: keep(&e.displacement),
-                loop_force: keep(&e.force),
-                slider_velocity: keep(&e.slider_velocity),
+            .flat_map(|e| {
+                let d = e.displacement.len();
+                (0..d).map(move |a| ElementRecord {
+                    name: if d == 1 { e.name.clone() } else { format!("{}.{}", e.name, a + 1) },
+                    energy_j: if d == 1 { e.energy_per_cycle } else { e.direction_energy[a] },
+                    stick_fraction: e.stick_fraction,
+                    loop_u: keep(&e.displacement[a]),
+                    loop_force: keep(&e.force[a]),
+                    slider_velocity: keep(&e.slider_velocity[a]),
+                })
             })
             .collect(),
     }
