@@ -269,6 +269,16 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
+                LawSpec::Contact { tangential, preload, normal_stiffness, tangential_stiffness, friction, .. } => (
+                    if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
+                    format!(
+                        "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
+                        number(*preload),
+                        number(*normal_stiffness),
+                        number(*tangential_stiffness),
+                        number(*friction)
+                    ),
+                ),
             };
             let placement = match &j.placement {
                 Placement::Dof(d) => format!("DOF {d} and the ground"),
