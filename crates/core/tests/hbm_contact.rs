@@ -374,3 +374,191 @@ fn law_preload(law: &dyn Element) -> f64 {
     law.update(&open[3 - d..], &[0.0; 3][..d], &mut w[..d - 1], &mut g[..d], None);
     -g[d - 1]
 }
+
+/// The 2-D contact law in continuous time for `u_t = a cos θ`, `u_n = b cos(θ − φ)`, solved
+/// event by event: stick, slip and open phases in closed form (T = T_s + k_t (u_t − u_s),
+/// T = ±μN(θ), T = 0), switches located by bisection to round-off. Independent of the AFT's
+/// sampled return mapping; the reference for variable normal load (the closed forms of Yang,
+/// Chu & Menq 1998 solve the same law for these motions, but their text was not at hand).
+struct EventReference {
+    a: f64,
+    b: f64,
+    phi: f64,
+    kt: f64,
+    kn: f64,
+    mu: f64,
+    n0: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Phase {
+    Stick { t0: f64, u0: f64 },
+    Slip(f64),
+    Open,
+}
+
+impl EventReference {
+    fn ut(&self, th: f64) -> f64 {
+        self.a * th.cos()
+    }
+    fn dut(&self, th: f64) -> f64 {
+        -self.a * th.sin()
+    }
+    fn n_trial(&self, th: f64) -> f64 {
+        self.n0 + self.kn * self.b * (th - self.phi).cos()
+    }
+    fn dn(&self, th: f64) -> f64 {
+        -self.kn * self.b * (th - self.phi).sin()
+    }
+    fn force(&self, p: Phase, th: f64) -> f64 {
+        match p {
+            Phase::Stick { t0, u0 } => t0 + self.kt * (self.ut(th) - u0),
+            Phase::Slip(s) => s * self.mu * self.n_trial(th).max(0.0),
+            Phase::Open => 0.0,
+        }
+    }
+    /// Smallest of the functions that stay positive while phase `p` holds.
+    fn margin(&self, p: Phase, th: f64) -> f64 {
+        match p {
+            Phase::Stick { .. } => self.mu * self.n_trial(th) - self.force(p, th).abs(),
+            // Slip goes on while sticking would push the force beyond the moving threshold.
+            Phase::Slip(s) => (s * self.kt * self.dut(th) - self.mu * self.dn(th)).min(self.n_trial(th)),
+            Phase::Open => -self.n_trial(th),
+        }
+    }
+    /// The phase entered at a switch at θ from phase `p`.
+    fn next(&self, p: Phase, th: f64) -> Phase {
+        let closing = |th: f64| {
+            // Re-contact (or the end of a slip): slip if the spring would outrun μN, else stick.
+            let (v, dn) = (self.kt * self.dut(th), self.mu * self.dn(th));
+            if v.abs() > dn {
+                Phase::Slip(v.signum())
+            } else {
+                Phase::Stick { t0: self.force(p, th), u0: self.ut(th) }
+            }
+        };
+        match p {
+            Phase::Stick { .. } => {
+                if self.n_trial(th) <= 1e-12 * self.n0 {
+                    Phase::Open
+                } else {
+                    Phase::Slip(self.force(p, th).signum())
+                }
+            }
+            Phase::Slip(s) => {
+                if self.n_trial(th) <= 1e-12 * self.n0 {
+                    Phase::Open
+                } else {
+                    Phase::Stick { t0: s * self.mu * self.n_trial(th), u0: self.ut(th) }
+                }
+            }
+            Phase::Open => closing(th),
+        }
+    }
+    /// Energy per cycle ∮ T du_t and the first harmonic (cos, sin) of T over the third period.
+    fn solve(&self) -> (f64, f64, f64) {
+        let two_pi = 2.0 * PI;
+        let mut p = if self.n_trial(0.0) > 0.0 { Phase::Stick { t0: 0.0, u0: self.ut(0.0) } } else { Phase::Open };
+        let mut th = 0.0;
+        let (end, keep_from) = (3.0 * two_pi, 2.0 * two_pi);
+        let step = two_pi / 20000.0;
+        let (mut w, mut c1, mut s1) = (0.0, 0.0, 0.0);
+        while th < end {
+            // March to the next switch (a sign change of the margin), then bisect it.
+            let mut hi = th;
+            let mut switch = false;
+            while hi < end {
+                let next = (hi + step).min(end);
+                if self.margin(p, next) <= 0.0 && next > th + 1e-13 {
+                    let mut lo = hi.max(th);
+                    let mut up = next;
+                    for _ in 0..200 {
+                        let mid = 0.5 * (lo + up);
+                        if self.margin(p, mid) > 0.0 {
+                            lo = mid;
+                        } else {
+                            up = mid;
+                        }
+                    }
+                    hi = up;
+                    switch = true;
+                    break;
+                }
+                hi = next;
+            }
+            // Integrate the phase over [th, hi] ∩ [keep_from, end] by composite Simpson
+            // (smooth integrands inside a phase: 200 intervals give round-off accuracy).
+            let (lo, up) = (th.max(keep_from), hi);
+            if up > lo {
+                let m = 200;
+                let h = (up - lo) / m as f64;
+                for i in 0..=m {
+                    let x = lo + i as f64 * h;
+                    let wgt = if i == 0 || i == m {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    } * h
+                        / 3.0;
+                    let t = self.force(p, x);
+                    w += wgt * t * self.dut(x);
+                    c1 += wgt * t * x.cos() / PI;
+                    s1 += wgt * t * x.sin() / PI;
+                }
+            }
+            if switch {
+                p = self.next(p, hi);
+            }
+            th = hi;
+        }
+        (w, c1, s1)
+    }
+}
+
+#[test]
+fn variable_normal_load_matches_the_event_resolved_solution() {
+    // k_t = 1e6 N/m, k_n = 2e6 N/m, μ = 0.4, N0 = 400 N: μN0/k_t = 1.6e-4 m, the contact opens
+    // at u_n = −2e-4 m. Tangential amplitude 4e-4 m (2.5 μN0/k_t).
+    let (kt, kn, mu, n0, a) = (1e6, 2e6, 0.4, 400.0, 4e-4);
+    let law = Contact::new_2d(kt, kn, mu, n0).unwrap();
+    for (what, b, phi) in [
+        ("in phase, closed", 1e-4, 0.0),
+        ("in phase, partial separation", 3e-4, 0.0),
+        ("out of phase (90°), partial separation", 3e-4, PI / 2.0),
+        ("opposite phase, closed (the mirror of in phase: same W)", 1e-4, PI),
+        ("45°, partial separation", 4e-4, PI / 4.0),
+    ] {
+        let reference = EventReference { a, b, phi, kt, kn, mu, n0 };
+        let (w_ref, c_ref, s_ref) = reference.solve();
+        let mut errors = Vec::new();
+        for nt in [256, 1024, 4096] {
+            let plan = AftPlan::new(3, nt).unwrap();
+            let mut u = vec![0.0; 2 * plan.n_coeffs()];
+            u[cos_index(1) * 2] = a;
+            u[cos_index(1) * 2 + 1] = b * phi.cos();
+            u[sin_index(1) * 2 + 1] = b * phi.sin();
+            let (g, _, _) = aft(&law, &plan, &u);
+            let (c1, s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
+            // ∮ T du_t = π a s1 for u_t = a cos θ (harmonic 1 only moves).
+            let w = PI * a * (-s1);
+            let e_w = (w - w_ref).abs() / w_ref;
+            // Equivalent stiffness c1/a and the dissipative part s1, relative to |T_1|.
+            let e_1 = (c1 - c_ref).hypot(s1 - s_ref) / c_ref.hypot(s_ref);
+            errors.push((nt, e_w, e_1));
+        }
+        println!("{what}: W = {w_ref:.6e} J, k_eq = {:.6e} N/m, errors (n_t, W, T_1) {errors:?}", c_ref / a);
+        // The AFT places each switch to within a sample; the force is continuous across the
+        // switches, so the error is second order in 1/n_t: measured ≤ 8e-5, 9e-6, 5.8e-7 at
+        // 256, 1024, 4096 samples. Bounds 1e-3 (a tenth of the 1 % asked), 2e-5, 2e-6.
+        for (nt, e_w, e_1) in errors {
+            let bound = match nt {
+                256 => 1e-3,
+                1024 => 2e-5,
+                _ => 2e-6,
+            };
+            assert!(e_w < bound && e_1 < bound, "{what}, {nt} samples: energy {e_w:.2e}, harmonic 1 {e_1:.2e}");
+        }
+    }
+}
