@@ -6,7 +6,7 @@ use std::time::Instant;
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 use stickslip_core::continuation::{Options, Silent, TerminationReason};
-use stickslip_core::elements::{Element, Jenkins};
+use stickslip_core::elements::{Contact, Element, Jenkins};
 use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings, Jacobians};
 use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel,
@@ -156,12 +156,51 @@ fn newton_iteration_seconds(q: usize, harmonics: usize, runs: usize) -> f64 {
     median(times)
 }
 
+/// One Newton iteration with `c` 3-D contacts (q = 3c directions) on a grounded chain of
+/// 3c + 10 DOFs, each contact on three neighbouring relative motions (two tangential, one
+/// normal); returns (residual + Jacobian, LU solve) in seconds. The state is the linear
+/// response at a level where the contacts stick, slip and open over the period.
+fn newton_iteration_contact_seconds(c: usize, harmonics: usize, runs: usize) -> (f64, f64) {
+    let n = 3 * c + 10;
+    let linear = chain_with_joints(n, 0, true).linear;
+    let sites = (0..c)
+        .map(|e| {
+            let i = 3 * e + 5;
+            let law: Box<dyn Element> = Box::new(Contact::new_3d(2e7, 4e7, 0.5, 200.0).unwrap());
+            let directions = (0..3).map(|a| relative_direction(n, i + a, Some(i + a + 1))).collect();
+            ElementSite { name: format!("contact{e}"), law, directions }
+        })
+        .collect();
+    let model = NonlinearModel::new(linear, sites).unwrap();
+    let mut force = vec![0.0; n];
+    force[n - 1] = 1.0;
+    let mut hbm = CondensedHbm::new(&model, &force, HbmSettings { harmonics, samples: 300 }).unwrap();
+    let dim = hbm.dimension();
+    let omega = TWO_PI * 230.0;
+    let x = hbm.linear_solution(omega, 3000.0);
+    let mut r = vec![0.0; dim];
+    let mut jac = Mat::zeros(dim, dim);
+    let (mut eval, mut solve) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let t = Instant::now();
+        hbm.evaluate(&x, omega, 3000.0, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))
+            .unwrap();
+        eval.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let dx = jac.partial_piv_lu().solve(Mat::from_fn(dim, 1, |i, _| r[i]));
+        std::hint::black_box(dx);
+        solve.push(t.elapsed().as_secs_f64());
+    }
+    (median(eval), median(solve))
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "quick");
-    // Optional filters: `table6`, `paper`, `cost` (default: all).
+    // Optional filters: `table6`, `paper`, `cost`, `contact` (default: all).
     let wanted = |name: &str| {
-        let filters: Vec<&String> = args.iter().filter(|a| ["table6", "paper", "cost"].contains(&a.as_str())).collect();
+        let filters: Vec<&String> =
+            args.iter().filter(|a| ["table6", "paper", "cost", "contact"].contains(&a.as_str())).collect();
         filters.is_empty() || filters.iter().any(|f| *f == name)
     };
     let runs = if quick { 3 } else { 11 };
@@ -188,6 +227,28 @@ fn main() {
             print_sweep(&format!("137 DOFs, q = 4, {level} N, 170-300 Hz"), &f);
         }
         println!("{:<44} {:>9.3} ms for the 6 levels", "137 DOFs, q = 4, all levels", total * 1e3);
+    }
+    if wanted("contact") {
+        println!("cost of one Newton iteration with 3-D contacts (residual + Jacobian | LU), 300 samples:");
+        for &harmonics in &[3, 7] {
+            for &c in &[2, 8, 32, 100] {
+                let q = 3 * c;
+                let dim = (2 * harmonics + 1) * q;
+                let reps = if dim > 2000 {
+                    1
+                } else if dim > 500 {
+                    3
+                } else {
+                    runs
+                };
+                let (e, l) = newton_iteration_contact_seconds(c, harmonics, reps);
+                println!(
+                    "  N = {harmonics:>2}, q = {q:>3} ({dim:>5} unknowns): {:>10.3} ms + {:>10.3} ms",
+                    e * 1e3,
+                    l * 1e3
+                );
+            }
+        }
     }
     if !wanted("cost") {
         return;

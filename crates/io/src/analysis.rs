@@ -247,16 +247,21 @@ pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool
                 }
             })
             .collect(),
+        // One record per direction: `joint` for a one-direction element, `joint.1`, `joint.2`,
+        // ... otherwise (as the time integrator names its records), each with its own energy.
         elements: p
             .elements
             .iter()
-            .map(|e| ElementRecord {
-                name: e.name.clone(),
-                energy_j: e.energy_per_cycle,
-                stick_fraction: e.stick_fraction,
-                loop_u: keep(&e.displacement),
-                loop_force: keep(&e.force),
-                slider_velocity: keep(&e.slider_velocity),
+            .flat_map(|e| {
+                let d = e.displacement.len();
+                (0..d).map(move |a| ElementRecord {
+                    name: if d == 1 { e.name.clone() } else { format!("{}.{}", e.name, a + 1) },
+                    energy_j: if d == 1 { e.energy_per_cycle } else { e.direction_energy[a] },
+                    stick_fraction: e.stick_fraction,
+                    loop_u: keep(&e.displacement[a]),
+                    loop_force: keep(&e.force[a]),
+                    slider_velocity: keep(&e.slider_velocity[a]),
+                })
             })
             .collect(),
     }
@@ -392,6 +397,16 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
+                LawSpec::Contact { tangential, preload, normal_stiffness, tangential_stiffness, friction, .. } => (
+                    if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
+                    format!(
+                        "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
+                        number(*preload),
+                        number(*normal_stiffness),
+                        number(*tangential_stiffness),
+                        number(*friction)
+                    ),
+                ),
             };
             let placement = match &j.placement {
                 Placement::Dof(d) => format!("DOF {d} and the ground"),

@@ -70,7 +70,7 @@ impl Element for Jenkins {
         }
     }
 
-    fn replaced_stiffness(&self) -> f64 {
+    fn replaced_stiffness(&self, _a: usize, _b: usize) -> f64 {
         if self.replaces_stiffness {
             self.stiffness
         } else {

@@ -21,11 +21,13 @@
 //! steps. Both get the partial derivatives in [`Tangent`], from which the harmonic balance builds
 //! its analytic Jacobian by the chain rule through the recursion.
 
+mod contact;
 mod coulomb;
 mod cubic;
 mod iwan;
 mod jenkins;
 
+pub use contact::{Contact, MAX_FRICTION_COEFFICIENT};
 pub use coulomb::RegularizedCoulomb;
 pub use cubic::CubicSpring;
 pub use iwan::Iwan;
@@ -132,9 +134,11 @@ pub trait Element: Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// Stiffness of the linear model that the element replaces (paper form, Eq. 11: `k_J`), so
-    /// that the joint's own force is `f = g + k_J u`; 0 for elements that add to the model.
-    fn replaced_stiffness(&self) -> f64 {
+    /// Entry `(a, b)` of the d×d stiffness `K_r` of the linear model that the element replaces
+    /// (paper form, Eq. 11: `k_J`, a 1×1 matrix for a Jenkins element; `Vᵀ K V` of a stuck
+    /// contact), so that the joint's own force is `f = g + K_r u`; 0 for elements that add to
+    /// the model.
+    fn replaced_stiffness(&self, _a: usize, _b: usize) -> f64 {
         0.0
     }
 

@@ -267,7 +267,7 @@ impl ElementAft {
         }
         if let Some((mut jac, dg_domega)) = jacobian {
             if let Some(k) = slider {
-                self.slider_jacobian(plan, k, law.replaced_stiffness(), j0, jac);
+                self.slider_jacobian(plan, k, law.replaced_stiffness(0, 0), j0, jac);
                 dg_domega.iter_mut().for_each(|v| *v = 0.0);
                 return Ok(());
             }

@@ -45,16 +45,21 @@ impl OutputResult {
 #[derive(Clone, Debug)]
 pub struct ElementResult {
     pub name: String,
-    /// Energy dissipated per cycle, `∮ g du` (J).
+    /// Energy dissipated per cycle, `∮ gᵀ du` summed over the directions (J).
     pub energy_per_cycle: f64,
-    /// Fraction of the period during which the element sticks.
+    /// Energy per cycle of each direction, `∮ g_a du_a` (J): a contact's normal direction
+    /// dissipates nothing, its tangential ones share the friction work.
+    pub direction_energy: Vec<f64>,
+    /// Fraction of the period during which the element sticks (a contact that is open or
+    /// slips does not).
     pub stick_fraction: f64,
-    /// Relative displacement `u = Vᵀ U` over the period (m), first direction.
-    pub displacement: Vec<f64>,
-    /// The joint's own force (N): `f = g + k_J u` for a paper-form element (Eq. 11).
-    pub force: Vec<f64>,
-    /// Slider velocity (Eq. 33): 0 when stuck, `u̇` when slipping (m/s).
-    pub slider_velocity: Vec<f64>,
+    /// Relative displacement `u_a = V_aᵀ U` over the period (m), one series per direction.
+    pub displacement: Vec<Vec<f64>>,
+    /// The joint's own force (N) per direction: `f = g + K_r u` for a paper-form element
+    /// (Eq. 11, `K_r` the replaced d×d stiffness).
+    pub force: Vec<Vec<f64>>,
+    /// Slider velocity (Eq. 33) per direction: 0 when stuck, `u̇_a` when slipping (m/s).
+    pub slider_velocity: Vec<Vec<f64>>,
 }
 
 /// Everything reported at one converged point.
@@ -145,22 +150,37 @@ pub fn evaluate_point(
     for (e, site) in hbm.model().elements.iter().enumerate() {
         let d = site.law.n_dirs();
         // ∮ g du = π Σ_k k (s_k g_ck − c_k g_sk), exact for the truncated motion.
-        let mut energy = 0.0;
-        for a in offset..offset + d {
-            for k in 1..=nh {
-                let (ic, is) = (cos_index(k) * q + a, sin_index(k) * q + a);
-                energy += pi * k as f64 * (x[is] * g[ic] - x[ic] * g[is]);
-            }
-        }
+        let direction_energy: Vec<f64> = (offset..offset + d)
+            .map(|a| {
+                (1..=nh)
+                    .map(|k| {
+                        let (ic, is) = (cos_index(k) * q + a, sin_index(k) * q + a);
+                        pi * k as f64 * (x[is] * g[ic] - x[ic] * g[is])
+                    })
+                    .sum()
+            })
+            .collect();
         let aft = hbm.element_aft(e);
-        let kj = site.law.replaced_stiffness();
-        let displacement = aft.u[..nt].to_vec();
-        let force = (0..nt).map(|j| aft.g[j] + kj * aft.u[j]).collect();
-        let slider_velocity = (0..nt).map(|j| if aft.slipping[j] { aft.v[j] } else { 0.0 }).collect();
+        let law = site.law.as_ref();
+        let series = |a: usize| &aft.u[a * nt..(a + 1) * nt];
+        let displacement: Vec<Vec<f64>> = (0..d).map(|a| series(a).to_vec()).collect();
+        let force = (0..d)
+            .map(|a| {
+                (0..nt)
+                    .map(|j| {
+                        aft.g[a * nt + j]
+                            + (0..d).map(|b| law.replaced_stiffness(a, b) * aft.u[b * nt + j]).sum::<f64>()
+                    })
+                    .collect()
+            })
+            .collect();
+        let slider_velocity =
+            (0..d).map(|a| (0..nt).map(|j| if aft.slipping[j] { aft.v[a * nt + j] } else { 0.0 }).collect()).collect();
         let stuck = aft.slipping.iter().filter(|s| !**s).count();
         element_results.push(ElementResult {
             name: site.name.clone(),
-            energy_per_cycle: energy,
+            energy_per_cycle: direction_energy.iter().sum(),
+            direction_energy,
             stick_fraction: stuck as f64 / nt as f64,
             displacement,
             force,

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use faer::Side;
-use stickslip_core::elements::{CubicSpring, Element, Iwan, Jenkins, RegularizedCoulomb};
+use stickslip_core::elements::{Contact, CubicSpring, Element, Iwan, Jenkins, RegularizedCoulomb};
 use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, ModelError, NamedVector,
     NonlinearModel,
@@ -294,6 +294,20 @@ impl Study {
                 Box::new(RegularizedCoulomb::new(*threshold, *velocity_scale).map_err(element_error)?)
             }
             LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
+            LawSpec::Contact { tangential, normal, preload, normal_stiffness, tangential_stiffness, friction } => {
+                // Directions tangential first, then normal, as the element expects; a pair is
+                // U_a − U_b (no normalisation: the stiffnesses act on that difference).
+                let directions =
+                    tangential.iter().chain([normal]).map(|p| vector(space, p, &ctx)).collect::<Result<Vec<_>, _>>()?;
+                let (kt, kn) = (*tangential_stiffness, *normal_stiffness);
+                let law = if tangential.len() == 1 {
+                    Contact::new_2d(kt, kn, *friction, *preload)
+                } else {
+                    Contact::new_3d(kt, kn, *friction, *preload)
+                };
+                let law = Box::new(law.map_err(element_error)?);
+                return Ok((ElementSite { name: j.name.clone(), law, directions }, None));
+            }
         };
         Ok((ElementSite { name: j.name.clone(), law, directions: vec![v] }, replaced))
     }

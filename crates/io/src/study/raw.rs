@@ -121,6 +121,12 @@ pub(crate) struct RawJoint {
     pub sliders: Option<S<i64>>,
     pub velocity_scale: Option<S<f64>>,
     pub k3: Option<S<f64>>,
+    pub tangential: Option<S<Vec<Vec<String>>>>,
+    pub normal: Option<S<Vec<String>>>,
+    pub preload: Option<S<f64>>,
+    pub normal_stiffness: Option<S<f64>>,
+    pub tangential_stiffness: Option<S<f64>>,
+    pub friction: Option<S<f64>>,
 }
 
 #[derive(Deserialize)]

@@ -584,26 +584,152 @@ fn placement(
     }
 }
 
+/// A contact joint's directions: `tangential = [["a", "b"], ...]` (one pair for contact2d, two
+/// for contact3d) and `normal = ["a", "b"]`, each pair `[a, b]` meaning `U_a − U_b` and a single
+/// name a DOF against the ground. Its placement is the first tangential direction.
+fn contact_directions(
+    src: &Source,
+    r: &raw::RawJoint,
+    whole: &Range<usize>,
+    ctx: &str,
+) -> Result<(Vec<Placement>, Placement, Range<usize>), StudyError> {
+    if let Some(span) =
+        [&r.between.as_ref().map(|v| v.span()), &r.dof.as_ref().map(|v| v.span()), &r.vector.as_ref().map(|v| v.span())]
+            .into_iter()
+            .flatten()
+            .next()
+    {
+        return Err(src.invalid(span, format!("{ctx}: a contact is placed by `tangential = [[\"a\", \"b\"], ...]` and `normal = [\"a\", \"b\"]`, not by `between`, `dof` or `vector`")));
+    }
+    let pair = |names: &[String], span: &Range<usize>, key: &str| -> Result<Placement, StudyError> {
+        match names {
+            [a] => Ok(Placement::Dof(a.clone())),
+            [a, b] if a != b => Ok(Placement::Between(a.clone(), b.clone())),
+            _ => Err(src.invalid(span, format!("{ctx}: each direction of `{key}` is [\"a\", \"b\"] (U_a − U_b) or [\"a\"] (U_a against the ground) with different DOF names, got {names:?}"))),
+        }
+    };
+    let expected = if r.law.get_ref() == "contact2d" { 1 } else { 2 };
+    let Some(t) = &r.tangential else {
+        return Err(src.invalid(
+            whole,
+            format!(
+                "{ctx}: law {:?} needs `tangential`, {expected} DOF pair(s) such as [[\"a_x\", \"b_x\"]]",
+                r.law.get_ref()
+            ),
+        ));
+    };
+    if t.get_ref().len() != expected {
+        return Err(src.invalid(
+            &t.span(),
+            format!(
+                "{ctx}: law {:?} needs {expected} tangential direction(s), got {}",
+                r.law.get_ref(),
+                t.get_ref().len()
+            ),
+        ));
+    }
+    let tangential = t.get_ref().iter().map(|p| pair(p, &t.span(), "tangential")).collect::<Result<Vec<_>, _>>()?;
+    let Some(n) = &r.normal else {
+        return Err(src.invalid(whole, format!("{ctx}: law {:?} needs `normal`, a DOF pair [\"a\", \"b\"] whose U_a − U_b grows as the surfaces press together", r.law.get_ref())));
+    };
+    let normal = pair(n.get_ref(), &n.span(), "normal")?;
+    Ok((tangential, normal, t.span()))
+}
+
+fn contact_placement(
+    src: &Source,
+    r: &raw::RawJoint,
+    whole: &Range<usize>,
+    ctx: &str,
+) -> Result<(Placement, Range<usize>), StudyError> {
+    let (tangential, _, span) = contact_directions(src, r, whole, ctx)?;
+    Ok((tangential[0].clone(), span))
+}
+
+/// The contact law's parameters: stiffnesses > 0, friction coefficient in [0, 10], a preload
+/// that closes the contact at rest.
+fn contact_law(
+    src: &Source,
+    r: &raw::RawJoint,
+    whole: &Range<usize>,
+    ctx: &str,
+    law: &str,
+) -> Result<LawSpec, StudyError> {
+    let (tangential, normal, _) = contact_directions(src, r, whole, ctx)?;
+    let need = |v: &Option<S<f64>>, key: &str, unit: &str| -> Result<f64, StudyError> {
+        match v {
+            Some(v) => positive(src, v, ctx, key, unit),
+            None => Err(src.invalid(whole, format!("{ctx}: law {law:?} needs `{key}`{unit}"))),
+        }
+    };
+    let friction = match &r.friction {
+        None => {
+            return Err(src.invalid(whole, format!("{ctx}: law {law:?} needs `friction`, the friction coefficient μ")))
+        }
+        Some(f) => {
+            let mu = *f.get_ref();
+            let max = stickslip_core::elements::MAX_FRICTION_COEFFICIENT;
+            if !(mu.is_finite() && (0.0..=max).contains(&mu)) {
+                return Err(src.invalid(
+                    &f.span(),
+                    format!("{ctx}: friction must lie in [0, {max}] (a coefficient, not a force), got {mu}"),
+                ));
+            }
+            mu
+        }
+    };
+    let preload = match &r.preload {
+        None => {
+            return Err(src.invalid(whole, format!("{ctx}: law {law:?} needs `preload`, the normal load at rest (N)")))
+        }
+        Some(p) => {
+            let x = *p.get_ref();
+            if !(x.is_finite() && x > 0.0) {
+                return Err(src.invalid(
+                    &p.span(),
+                    format!("{ctx}: preload must be > 0 N, got {x}: the contact would be open at rest"),
+                ));
+            }
+            x
+        }
+    };
+    Ok(LawSpec::Contact {
+        tangential,
+        normal,
+        preload,
+        normal_stiffness: need(&r.normal_stiffness, "normal_stiffness", " N/m")?,
+        tangential_stiffness: need(&r.tangential_stiffness, "tangential_stiffness", " N/m")?,
+        friction,
+    })
+}
+
 fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
     let r = j.get_ref();
     check_name(src, &r.name, "[[joint]]")?;
     let ctx = format!("[[joint]] {:?}", r.name.get_ref());
-    let (placement, pspan) = placement(src, r, &j.span(), &ctx)?;
     let law_name = r.law.get_ref().as_str();
+    let is_contact = matches!(law_name, "contact2d" | "contact3d");
+    let (placement, pspan) =
+        if is_contact { contact_placement(src, r, &j.span(), &ctx)? } else { placement(src, r, &j.span(), &ctx)? };
     // Keys each law accepts, to reject parameters of another law (a likely mix-up).
     let allowed: &[&str] = match law_name {
         "jenkins" => &["threshold", "stiffness", "replaces_stiffness"],
         "iwan" => &["stiffness", "replaces_stiffness", "slip_force", "sliders"],
         "coulomb" => &["threshold", "velocity_scale"],
         "cubic" => &["k3"],
+        "contact2d" | "contact3d" => &["preload", "normal_stiffness", "tangential_stiffness", "friction"],
         other => {
             return Err(src.invalid(
                 &r.law.span(),
-                format!("{ctx}: unknown law {other:?}, expected one of \"jenkins\", \"iwan\", \"coulomb\", \"cubic\""),
+                format!("{ctx}: unknown law {other:?}, expected one of \"jenkins\", \"iwan\", \"coulomb\", \"cubic\", \"contact2d\", \"contact3d\""),
             ))
         }
     };
-    let present: [(&str, Option<Range<usize>>); 7] = [
+    let present: [(&str, Option<Range<usize>>); 11] = [
+        ("preload", r.preload.as_ref().map(|v| v.span())),
+        ("normal_stiffness", r.normal_stiffness.as_ref().map(|v| v.span())),
+        ("tangential_stiffness", r.tangential_stiffness.as_ref().map(|v| v.span())),
+        ("friction", r.friction.as_ref().map(|v| v.span())),
         ("threshold", r.threshold.as_ref().map(|v| v.span())),
         ("stiffness", r.stiffness.as_ref().map(|v| v.span())),
         ("replaces_stiffness", r.replaces_stiffness.as_ref().map(|v| v.span())),
@@ -659,6 +785,7 @@ fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
             threshold: need(&r.threshold, "threshold", " N")?,
             velocity_scale: need(&r.velocity_scale, "velocity_scale", " m/s")?,
         },
+        "contact2d" | "contact3d" => contact_law(src, r, &j.span(), &ctx, law_name)?,
         _ => LawSpec::Cubic {
             k3: match &r.k3 {
                 Some(k) => finite(src, k, &ctx, "k3")?,

@@ -1,0 +1,564 @@
+//! Contact elements (2-D, 3-D) in the harmonic balance: the AFT Jacobian, the gross-slip closed
+//! form on a circular path, the equivalence with the Jenkins element under a constant normal
+//! load, and the condensed balance against the full one with several contacts.
+mod hbm_support;
+
+use faer::linalg::solvers::Solve;
+use faer::Mat;
+use hbm_support::*;
+use stickslip_core::elements::{Contact, Element, Jenkins};
+use stickslip_core::hbm::fourier::{cos_index, sin_index};
+use stickslip_core::hbm::{AftPlan, CondensedHbm, ElementAft, FullHbm, HbmSettings};
+use stickslip_core::model::{relative_direction, Damping, DofLabel, ElementSite, LinearModel, NonlinearModel};
+use stickslip_core::post::{evaluate_point, OutputSelector};
+
+const PI: f64 = std::f64::consts::PI;
+
+/// AFT of `law` for coefficient-major harmonics `u` (`u[c·d + a]`), with the Jacobian.
+fn aft(law: &dyn Element, plan: &AftPlan, u: &[f64]) -> (Vec<f64>, Mat<f64>, ElementAft) {
+    let n = u.len();
+    let mut a = ElementAft::new(law, plan);
+    let (mut g, mut j, mut w) = (vec![0.0; n], Mat::zeros(n, n), vec![0.0; n]);
+    a.evaluate(law, plan, 700.0, u, &mut g, Some((j.as_mut(), &mut w))).unwrap();
+    (g, j, a)
+}
+
+/// Largest difference between the analytic AFT Jacobian and central differences, relative to
+/// the Jacobian's largest entry.
+fn jacobian_error(law: &dyn Element, u: &[f64]) -> f64 {
+    let plan = AftPlan::new(4, 256).unwrap();
+    let n = u.len();
+    let (_, jac, mut a) = aft(law, &plan, u);
+    let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max(jac[(i, j)].abs()));
+    let h = 1e-7 * u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+    let mut worst = 0.0f64;
+    for col in 0..n {
+        let (mut up, mut um) = (u.to_vec(), u.to_vec());
+        up[col] += h;
+        um[col] -= h;
+        a.evaluate(law, &plan, 700.0, &up, &mut gp, None).unwrap();
+        a.evaluate(law, &plan, 700.0, &um, &mut gm, None).unwrap();
+        for row in 0..n {
+            worst = worst.max(((gp[row] - gm[row]) / (2.0 * h) - jac[(row, col)]).abs() / scale);
+        }
+    }
+    worst
+}
+
+/// Harmonics (N = 4) of a d-direction motion: tangential ellipse(s) with a mean and harmonic 2,
+/// normal motion of amplitude `normal` with phase `phase` relative to the first tangential one.
+fn contact_motion(d: usize, tangential: f64, normal: f64, phase: f64) -> Vec<f64> {
+    let nc = 9;
+    let mut u = vec![0.0; nc * d];
+    let t = tangential;
+    u[cos_index(1) * d] = t;
+    u[sin_index(1) * d] = 0.3 * t;
+    u[sin_index(2) * d] = -0.1 * t;
+    u[0] = 0.05 * t;
+    if d == 3 {
+        u[cos_index(1) * d + 1] = -0.2 * t;
+        u[sin_index(1) * d + 1] = 0.8 * t;
+        u[cos_index(2) * d + 1] = 0.1 * t;
+    }
+    let n = d - 1;
+    u[cos_index(1) * d + n] = normal * phase.cos();
+    u[sin_index(1) * d + n] = normal * phase.sin();
+    u[cos_index(2) * d + n] = 0.1 * normal;
+    u
+}
+
+#[test]
+fn contact_aft_jacobians_equal_finite_differences() {
+    // k_t = 1e6 N/m, k_n = 2e6 N/m, μ = 0.5, N0 = 100 N: the tangential spring reaches the
+    // threshold μN0 = 50 N at 5e-5 m, the contact opens at u_n = −5e-5 m. As for the Jenkins
+    // element (element_aft tests), a perturbation h moves each stick/slip/open switch by O(h),
+    // which central differences see as a kink in one sample of 256: error O(h·k/n_t) relative,
+    // measured ≤ 1.6e-9 over these cases; bound 1e-7.
+    let (kt, kn, mu, n0) = (1e6, 2e6, 0.5, 100.0);
+    for d in [2, 3] {
+        let law = if d == 2 { Contact::new_2d(kt, kn, mu, n0) } else { Contact::new_3d(kt, kn, mu, n0) }.unwrap();
+        for (what, t, n, phase) in [
+            ("stuck", 2e-5, 1e-5, 0.0),
+            ("stick-slip, in-phase normal load", 8e-5, 3e-5, 0.0),
+            ("stick-slip, out-of-phase normal load", 8e-5, 3e-5, PI / 2.0),
+            ("gross slip with separation", 4e-4, 8e-5, 0.7),
+        ] {
+            let e = jacobian_error(&law, &contact_motion(d, t, n, phase));
+            println!("{d}-D contact, {what}: {e:.2e}");
+            assert!(e < 1e-7, "{d}-D contact, {what}: Jacobian vs finite differences {e:.2e}");
+        }
+    }
+}
+
+#[test]
+fn circular_gross_slip_dissipates_mu_n_times_the_slider_path() {
+    // u_t = R (cos θ, sin θ), constant N = N0: in the periodic regime the slider turns on a
+    // circle of radius R' = √(R² − r²), r = μN/k_t (the spring stays tangent to the slider's
+    // circle, the slip being along the force), and W = μN · 2πR'.
+    let (kt, kn, mu, n0, r_path) = (1e6, 2e6, 0.3, 500.0, 5e-4);
+    let law = Contact::new_3d(kt, kn, mu, n0).unwrap();
+    let plan = AftPlan::new(3, 300).unwrap();
+    let nc = plan.n_coeffs();
+    let mut u = vec![0.0; nc * 3];
+    u[cos_index(1) * 3] = r_path;
+    u[sin_index(1) * 3 + 1] = r_path;
+    let (g, _, a) = aft(&law, &plan, &u);
+    let limit = mu * n0;
+    let r = limit / kt;
+    let w_exact = limit * 2.0 * PI * (r_path * r_path - r * r).sqrt();
+    let w_aft: f64 = (0..2)
+        .map(|a| {
+            PI * (u[sin_index(1) * 3 + a] * g[cos_index(1) * 3 + a] - u[cos_index(1) * 3 + a] * g[sin_index(1) * 3 + a])
+        })
+        .sum();
+    // The return mapping is implicit (backward Euler): the force at a sample is the one at the
+    // end of the step, which lags the continuous solution by half a step and tilts the force
+    // by π/n_t against the path, W changing by ≈ (r/R)·π/n_t relative: first order, measured
+    // 3.34e-3, 8.26e-4, 2.06e-4 at 300, 1200, 4800 samples for r/R = 0.3. Bounds: 4e-3 at 300,
+    // and the 1e-3 of the closed-form check reached from 1200 samples on.
+    let err = (w_aft - w_exact).abs() / w_exact;
+    assert!(err < 4e-3, "energy per cycle {w_aft:.6e} J vs μN·2πR' = {w_exact:.6e} J ({err:.2e})");
+    {
+        let fine = AftPlan::new(3, 1200).unwrap();
+        let mut uf = vec![0.0; nc * 3];
+        uf[cos_index(1) * 3] = r_path;
+        uf[sin_index(1) * 3 + 1] = r_path;
+        let (gf, _, _) = aft(&law, &fine, &uf);
+        let wf: f64 = (0..2)
+            .map(|a| {
+                PI * (uf[sin_index(1) * 3 + a] * gf[cos_index(1) * 3 + a]
+                    - uf[cos_index(1) * 3 + a] * gf[sin_index(1) * 3 + a])
+            })
+            .sum();
+        let ef = (wf - w_exact).abs() / w_exact;
+        assert!(ef < 1e-3 && ef < err / 3.5, "1200 samples: {ef:.2e} (300: {err:.2e}), not first order");
+    }
+    let nt = plan.n_samples();
+    for j in 0..nt {
+        // Force of magnitude μN (to round-off) at every sample, and the slider's step from the
+        // previous sample along it: the friction force on the sliding body opposes its slip.
+        let (t1, t2) = (a.g[j], a.g[nt + j]);
+        assert!((t1.hypot(t2) - limit).abs() < 1e-12 * limit, "sample {j}: |T| = {}", t1.hypot(t2));
+        let p = (j + nt - 1) % nt;
+        let (w1, w2) = (a.u[j] - t1 / kt, a.u[nt + j] - t2 / kt);
+        let (w1p, w2p) = (a.u[p] - a.g[p] / kt, a.u[nt + p] - a.g[nt + p] / kt);
+        let (s1, s2) = (w1 - w1p, w2 - w2p);
+        let cos = (s1 * t1 + s2 * t2) / (s1.hypot(s2) * limit);
+        assert!((cos - 1.0).abs() < 1e-9, "sample {j}: slip not along the force (cos {cos})");
+        assert!(a.slipping[j]);
+    }
+    assert!(a.u[2 * nt..].iter().all(|x| x.abs() < 1e-30));
+}
+
+/// The Table 6 oscillator with `extra` decoupled DOFs (mass 2 kg, stiffness 3e7 N/m) standing
+/// for the contact's other directions; `law` acts on x and those DOFs. Standalone form
+/// (`replaced` None): K holds K − k_J along x and the joint adds its own stiffness. Paper form:
+/// K also holds the stuck contact stiffness `replaced[i]` along each direction, which the joint
+/// replaces.
+fn oscillator(extra: usize, law: Box<dyn Element>, replaced: Option<&[f64]>) -> NonlinearModel {
+    let n = 1 + extra;
+    let k = |i: usize| match (i, replaced) {
+        (0, None) => K_TOTAL - K_JENKINS,
+        (_, None) => 3e7,
+        (_, Some(r)) => (if i == 0 { K_TOTAL - K_JENKINS } else { 3e7 }) + r[i],
+    };
+    let linear = LinearModel::new(
+        dense(n, |i, j| {
+            if i != j {
+                0.0
+            } else if i == 0 {
+                MASS
+            } else {
+                2.0
+            }
+        }),
+        dense(n, |i, j| if i != j { 0.0 } else { k(i) }),
+        Damping::Matrix(dense(n, |i, j| {
+            if i != j {
+                0.0
+            } else if i == 0 {
+                DAMPING
+            } else {
+                50.0
+            }
+        })),
+        (0..n).map(|i| DofLabel::named(format!("x{i}"))).collect(),
+        vec![],
+    )
+    .unwrap();
+    let directions = (0..n).map(|i| relative_direction(n, i, None)).collect();
+    NonlinearModel::new(linear, vec![ElementSite { name: "joint".into(), law, directions }]).unwrap()
+}
+
+#[test]
+fn contacts_under_constant_normal_load_and_1d_motion_equal_the_jenkins_element() {
+    // F_c = μ N0 with μ = 0.5, N0 = 2000 N; the normal and second tangential DOFs are not
+    // forced and not coupled to x, so they stay at rest and the threshold stays μN0. The
+    // contact's return mapping then does the Jenkins element's operations (|T_tr| of a
+    // one-component vector is its absolute value, T_tr/|T_tr| = ±1 exactly): the residuals
+    // agree to round-off and so do the solutions. Bound 1e-12 relative.
+    let (mu, n0, kn) = (0.5, 2000.0, 5e6);
+    let settings = HbmSettings { harmonics: 7, samples: 300 };
+    let nc = 2 * settings.harmonics + 1;
+    for paper in [false, true] {
+        let jenkins: Box<dyn Element> = if paper {
+            Box::new(Jenkins::replacing_stiffness(K_JENKINS, mu * n0).unwrap())
+        } else {
+            Box::new(Jenkins::new(K_JENKINS, mu * n0).unwrap())
+        };
+        let reference = oscillator(0, jenkins, paper.then_some(&[K_JENKINS][..]));
+        let mut h_ref = CondensedHbm::new(&reference, &[F_EXCIT], settings).unwrap();
+        for d in [2, 3] {
+            let law =
+                if d == 2 { Contact::new_2d(K_JENKINS, kn, mu, n0) } else { Contact::new_3d(K_JENKINS, kn, mu, n0) }
+                    .unwrap();
+            // Stuck closed contact: k_t along the tangential directions, k_n along the normal.
+            let diag: Vec<f64> = (0..d).map(|i| if i + 1 < d { K_JENKINS } else { kn }).collect();
+            let law: Box<dyn Element> = if paper {
+                let kr: Vec<f64> = (0..d * d).map(|i| if i % (d + 1) == 0 { diag[i / d] } else { 0.0 }).collect();
+                Box::new(law.replacing_stiffness(&kr).unwrap())
+            } else {
+                Box::new(law)
+            };
+            let model = oscillator(d - 1, law, paper.then_some(&diag[..]));
+            let mut force = vec![0.0; d];
+            force[0] = F_EXCIT;
+            let mut h = CondensedHbm::new(&model, &force, settings).unwrap();
+            let mut worst = 0.0f64;
+            let mut slipped = false;
+            // Natural continuation on a 1 Hz grid across the resonance, from the stuck solution.
+            let mut x0 = h_ref.stuck_solution(TWO_PI * 200.0, 1.0).unwrap();
+            for f in (0..=60).map(|i| 200.0 + i as f64) {
+                let omega = TWO_PI * f;
+                let (xr, _) = h_ref.solve(omega, 1.0, &x0, 1e-14, 60).unwrap();
+                x0.clone_from(&xr);
+                // The same point embedded in the contact's unknowns (other directions at rest).
+                let embed = |x: &[f64]| -> Vec<f64> {
+                    let mut y = vec![0.0; nc * d];
+                    for c in 0..nc {
+                        y[c * d] = x[c];
+                    }
+                    y
+                };
+                let (mut r1, mut r2) = (vec![0.0; nc], vec![0.0; nc * d]);
+                h_ref.evaluate(&xr, omega, 1.0, &mut r1, None).unwrap();
+                h.evaluate(&embed(&xr), omega, 1.0, &mut r2, None).unwrap();
+                let xn = norm(&xr);
+                for c in 0..nc {
+                    worst = worst.max((r1[c] - r2[c * d]).abs() / xn);
+                    for a in 1..d {
+                        assert!(r2[c * d + a].abs() < 1e-15 * xn, "{f} Hz: direction {a} is not at rest");
+                    }
+                }
+                let (xc, _) = h.solve(omega, 1.0, &embed(&xr), 1e-14, 60).unwrap();
+                for c in 0..nc {
+                    worst = worst.max((xc[c * d] - xr[c]).abs() / xn);
+                }
+                // The joint slips at these frequencies (else the test checks linear algebra).
+                let p = evaluate_point(&mut h, &xc, omega, 1.0, &[]).unwrap();
+                slipped |= p.elements[0].stick_fraction < 0.9 && p.elements[0].energy_per_cycle > 0.0;
+            }
+            assert!(slipped, "the joint never slips");
+            println!("paper form {paper}, {d}-direction contact vs Jenkins: {worst:.2e}");
+            assert!(worst < 1e-12, "paper form {paper}, {d}-direction contact vs Jenkins: {worst:.2e}");
+        }
+    }
+}
+
+/// A chain of 14 DOFs with three contacts (two 2-D, one 3-D, between DOFs and to the ground).
+fn contact_chain(damping: Damping) -> NonlinearModel {
+    let n = 14;
+    let base = chain(n, damping, vec![]);
+    let c2 = |kt, kn, mu, n0| -> Box<dyn Element> { Box::new(Contact::new_2d(kt, kn, mu, n0).unwrap()) };
+    let sites = vec![
+        ElementSite {
+            name: "a".into(),
+            law: c2(3e5, 4e5, 0.4, 30.0),
+            directions: vec![relative_direction(n, 3, Some(4)), relative_direction(n, 5, Some(4))],
+        },
+        ElementSite {
+            name: "b".into(),
+            law: Box::new(Contact::new_3d(2e5, 3e5, 0.3, 40.0).unwrap()),
+            directions: vec![
+                relative_direction(n, 8, None),
+                relative_direction(n, 9, None),
+                relative_direction(n, 7, None),
+            ],
+        },
+        ElementSite {
+            name: "c".into(),
+            law: c2(2.5e5, 2e5, 0.6, 20.0),
+            directions: vec![relative_direction(n, 12, Some(13)), relative_direction(n, 11, None)],
+        },
+    ];
+    NonlinearModel::new(base.linear, sites).unwrap()
+}
+
+#[test]
+fn condensed_solution_equals_the_full_solution_with_three_contacts() {
+    let n = 14;
+    for damping in [
+        Damping::Rayleigh { alpha: 15.0, beta: 1e-6 },
+        Damping::Matrix(dense(n, |i, j| if i == j { 25.0 } else { 0.0 })),
+    ] {
+        let model = contact_chain(damping);
+        let mut force = vec![0.0; n];
+        force[0] = 1.0;
+        force[7] = -0.5;
+        let settings = HbmSettings { harmonics: 5, samples: 128 };
+        let modes = model.linear.dense_modes().unwrap();
+        let omega = 0.97 * modes.omega[0];
+        let level = 400.0;
+        let mut cond = CondensedHbm::new(&model, &force, settings).unwrap();
+        let x0 = cond.linear_solution(omega, level);
+        let (xq, _) = cond.solve(omega, level, &x0, 1e-13, 80).unwrap();
+        let outputs: Vec<OutputSelector> =
+            (0..n).map(|i| OutputSelector { name: format!("x{i}"), vector: relative_direction(n, i, None) }).collect();
+        let p = evaluate_point(&mut cond, &xq, omega, level, &outputs).unwrap();
+        // Every contact slips, and at least one opens over part of the cycle.
+        let states: Vec<(f64, f64)> = p.elements.iter().map(|e| (e.energy_per_cycle, e.stick_fraction)).collect();
+        assert!(states.iter().all(|&(w, stick)| w > 0.0 && stick < 0.99), "no slip: {states:?}");
+        let opened = p.elements.iter().any(|e| {
+            let law = model.elements.iter().find(|s| s.name == e.name).unwrap();
+            e.force.last().unwrap().iter().any(|&g| g + law_preload(law.law.as_ref()) <= 1e-9)
+        });
+        assert!(opened, "no contact opens");
+        // Normal directions dissipate nothing (elastic unilateral law): |W_n| ≤ 1e-9 of the total.
+        // Normal directions dissipate nothing: g_n is a function of u_n alone, so ∮ g_n du_n
+        // vanishes but for the quadrature of its kink at opening on 128 samples. Measured
+        // ≤ 1e-4 of the normal energy scale max|g_n| · (max u_n − min u_n); bound 2e-3.
+        for e in &p.elements {
+            let wn = *e.direction_energy.last().unwrap();
+            let (un, gn) = (e.displacement.last().unwrap(), e.force.last().unwrap());
+            let range = un.iter().fold(f64::MIN, |m, x| m.max(*x)) - un.iter().fold(f64::MAX, |m, x| m.min(*x));
+            let scale = gn.iter().fold(0.0f64, |m, x| m.max(x.abs())) * range;
+            println!("{}: normal work {:.2e} of the normal energy scale", e.name, wn / scale);
+            assert!(wn.abs() < 2e-3 * scale, "{}: normal work {wn:e} J, scale {scale:e} J", e.name);
+        }
+        let nc = 2 * settings.harmonics + 1;
+        let recovered: Vec<f64> = (0..nc * n).map(|idx| p.outputs[idx % n].coeffs[idx / n]).collect();
+        let mut full = FullHbm::new(&model, &force, settings).unwrap();
+        let dim = full.dimension();
+        let mut x: Vec<f64> = recovered.iter().map(|v| v * 1.01).collect();
+        let mut r = vec![0.0; dim];
+        let mut j = Mat::zeros(dim, dim);
+        for _ in 0..60 {
+            full.evaluate(&x, omega, level, &mut r, Some(j.as_mut())).unwrap();
+            let dx = j.partial_piv_lu().solve(Mat::from_fn(dim, 1, |i, _| r[i]));
+            for i in 0..dim {
+                x[i] -= dx[(i, 0)];
+            }
+            if norm(&(0..dim).map(|i| dx[(i, 0)]).collect::<Vec<_>>()) < 1e-15 * norm(&x) {
+                break;
+            }
+        }
+        full.evaluate(&x, omega, level, &mut r, None).unwrap();
+        assert!(norm(&r) < 1e-9 * level, "full balance not converged: {:.2e}", norm(&r));
+        // Both solve the same equations to round-off (condensed to 1e-13 of ‖x‖; measured
+        // 3e-15 apart); 1e-8 leaves room for the full solve's conditioning on other machines.
+        let diff: Vec<f64> = x.iter().zip(&recovered).map(|(a, b)| a - b).collect();
+        let err = norm(&diff) / norm(&x);
+        println!("condensed vs full: {err:.2e}");
+        assert!(err < 1e-8, "condensed vs full: {err:.2e}");
+    }
+}
+
+fn law_preload(law: &dyn Element) -> f64 {
+    // The restoring normal force is N − N0: open where it equals −N0. The three contacts'
+    // preloads, by kind and threshold of the chain above.
+    let mut g = [0.0; 3];
+    let mut w = [0.0; 2];
+    let d = law.n_dirs();
+    let open = [0.0, 0.0, -1.0];
+    law.update(&open[3 - d..], &[0.0; 3][..d], &mut w[..d - 1], &mut g[..d], None);
+    -g[d - 1]
+}
+
+/// The 2-D contact law in continuous time for `u_t = a cos θ`, `u_n = b cos(θ − φ)`, solved
+/// event by event: stick, slip and open phases in closed form (T = T_s + k_t (u_t − u_s),
+/// T = ±μN(θ), T = 0), switches located by bisection to round-off. Independent of the AFT's
+/// sampled return mapping; the reference for variable normal load (the closed forms of Yang,
+/// Chu & Menq 1998 solve the same law for these motions, but their text was not at hand).
+struct EventReference {
+    a: f64,
+    b: f64,
+    phi: f64,
+    kt: f64,
+    kn: f64,
+    mu: f64,
+    n0: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Phase {
+    Stick { t0: f64, u0: f64 },
+    Slip(f64),
+    Open,
+}
+
+impl EventReference {
+    fn ut(&self, th: f64) -> f64 {
+        self.a * th.cos()
+    }
+    fn dut(&self, th: f64) -> f64 {
+        -self.a * th.sin()
+    }
+    fn n_trial(&self, th: f64) -> f64 {
+        self.n0 + self.kn * self.b * (th - self.phi).cos()
+    }
+    fn dn(&self, th: f64) -> f64 {
+        -self.kn * self.b * (th - self.phi).sin()
+    }
+    fn force(&self, p: Phase, th: f64) -> f64 {
+        match p {
+            Phase::Stick { t0, u0 } => t0 + self.kt * (self.ut(th) - u0),
+            Phase::Slip(s) => s * self.mu * self.n_trial(th).max(0.0),
+            Phase::Open => 0.0,
+        }
+    }
+    /// Smallest of the functions that stay positive while phase `p` holds.
+    fn margin(&self, p: Phase, th: f64) -> f64 {
+        match p {
+            Phase::Stick { .. } => self.mu * self.n_trial(th) - self.force(p, th).abs(),
+            // Slip goes on while sticking would push the force beyond the moving threshold.
+            Phase::Slip(s) => (s * self.kt * self.dut(th) - self.mu * self.dn(th)).min(self.n_trial(th)),
+            Phase::Open => -self.n_trial(th),
+        }
+    }
+    /// The phase entered at a switch at θ from phase `p`.
+    fn next(&self, p: Phase, th: f64) -> Phase {
+        let closing = |th: f64| {
+            // Re-contact (or the end of a slip): slip if the spring would outrun μN, else stick.
+            let (v, dn) = (self.kt * self.dut(th), self.mu * self.dn(th));
+            if v.abs() > dn {
+                Phase::Slip(v.signum())
+            } else {
+                Phase::Stick { t0: self.force(p, th), u0: self.ut(th) }
+            }
+        };
+        match p {
+            Phase::Stick { .. } => {
+                if self.n_trial(th) <= 1e-12 * self.n0 {
+                    Phase::Open
+                } else {
+                    Phase::Slip(self.force(p, th).signum())
+                }
+            }
+            Phase::Slip(s) => {
+                if self.n_trial(th) <= 1e-12 * self.n0 {
+                    Phase::Open
+                } else {
+                    Phase::Stick { t0: s * self.mu * self.n_trial(th), u0: self.ut(th) }
+                }
+            }
+            Phase::Open => closing(th),
+        }
+    }
+    /// Energy per cycle ∮ T du_t and the first harmonic (cos, sin) of T over the third period.
+    fn solve(&self) -> (f64, f64, f64) {
+        let two_pi = 2.0 * PI;
+        let mut p = if self.n_trial(0.0) > 0.0 { Phase::Stick { t0: 0.0, u0: self.ut(0.0) } } else { Phase::Open };
+        let mut th = 0.0;
+        let (end, keep_from) = (3.0 * two_pi, 2.0 * two_pi);
+        let step = two_pi / 20000.0;
+        let (mut w, mut c1, mut s1) = (0.0, 0.0, 0.0);
+        while th < end {
+            // March to the next switch (a sign change of the margin), then bisect it.
+            let mut hi = th;
+            let mut switch = false;
+            while hi < end {
+                let next = (hi + step).min(end);
+                if self.margin(p, next) <= 0.0 && next > th + 1e-13 {
+                    let mut lo = hi.max(th);
+                    let mut up = next;
+                    for _ in 0..200 {
+                        let mid = 0.5 * (lo + up);
+                        if self.margin(p, mid) > 0.0 {
+                            lo = mid;
+                        } else {
+                            up = mid;
+                        }
+                    }
+                    hi = up;
+                    switch = true;
+                    break;
+                }
+                hi = next;
+            }
+            // Integrate the phase over [th, hi] ∩ [keep_from, end] by composite Simpson
+            // (smooth integrands inside a phase: 200 intervals give round-off accuracy).
+            let (lo, up) = (th.max(keep_from), hi);
+            if up > lo {
+                let m = 200;
+                let h = (up - lo) / m as f64;
+                for i in 0..=m {
+                    let x = lo + i as f64 * h;
+                    let wgt = if i == 0 || i == m {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    } * h
+                        / 3.0;
+                    let t = self.force(p, x);
+                    w += wgt * t * self.dut(x);
+                    c1 += wgt * t * x.cos() / PI;
+                    s1 += wgt * t * x.sin() / PI;
+                }
+            }
+            if switch {
+                p = self.next(p, hi);
+            }
+            th = hi;
+        }
+        (w, c1, s1)
+    }
+}
+
+#[test]
+fn variable_normal_load_matches_the_event_resolved_solution() {
+    // k_t = 1e6 N/m, k_n = 2e6 N/m, μ = 0.4, N0 = 400 N: μN0/k_t = 1.6e-4 m, the contact opens
+    // at u_n = −2e-4 m. Tangential amplitude 4e-4 m (2.5 μN0/k_t).
+    let (kt, kn, mu, n0, a) = (1e6, 2e6, 0.4, 400.0, 4e-4);
+    let law = Contact::new_2d(kt, kn, mu, n0).unwrap();
+    for (what, b, phi) in [
+        ("in phase, closed", 1e-4, 0.0),
+        ("in phase, partial separation", 3e-4, 0.0),
+        ("out of phase (90°), partial separation", 3e-4, PI / 2.0),
+        ("opposite phase, closed (the mirror of in phase: same W)", 1e-4, PI),
+        ("45°, partial separation", 4e-4, PI / 4.0),
+    ] {
+        let reference = EventReference { a, b, phi, kt, kn, mu, n0 };
+        let (w_ref, c_ref, s_ref) = reference.solve();
+        let mut errors = Vec::new();
+        for nt in [256, 1024, 4096] {
+            let plan = AftPlan::new(3, nt).unwrap();
+            let mut u = vec![0.0; 2 * plan.n_coeffs()];
+            u[cos_index(1) * 2] = a;
+            u[cos_index(1) * 2 + 1] = b * phi.cos();
+            u[sin_index(1) * 2 + 1] = b * phi.sin();
+            let (g, _, _) = aft(&law, &plan, &u);
+            let (c1, s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
+            // ∮ T du_t = π a s1 for u_t = a cos θ (harmonic 1 only moves).
+            let w = PI * a * (-s1);
+            let e_w = (w - w_ref).abs() / w_ref;
+            // Equivalent stiffness c1/a and the dissipative part s1, relative to |T_1|.
+            let e_1 = (c1 - c_ref).hypot(s1 - s_ref) / c_ref.hypot(s_ref);
+            errors.push((nt, e_w, e_1));
+        }
+        println!("{what}: W = {w_ref:.6e} J, k_eq = {:.6e} N/m, errors (n_t, W, T_1) {errors:?}", c_ref / a);
+        // The AFT places each switch to within a sample; the force is continuous across the
+        // switches, so the error is second order in 1/n_t: measured ≤ 8e-5, 9e-6, 5.8e-7 at
+        // 256, 1024, 4096 samples. Bounds 1e-3 (a tenth of the 1 % asked), 2e-5, 2e-6.
+        for (nt, e_w, e_1) in errors {
+            let bound = match nt {
+                256 => 1e-3,
+                1024 => 2e-5,
+                _ => 2e-6,
+            };
+            assert!(e_w < bound && e_1 < bound, "{what}, {nt} samples: energy {e_w:.2e}, harmonic 1 {e_1:.2e}");
+        }
+    }
+}
