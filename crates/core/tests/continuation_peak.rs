@@ -75,7 +75,8 @@ fn the_peak_of_a_linear_oscillator_is_located_at_its_closed_form() {
     assert!((sampled.lambda - w_peak).abs() > 1e-5 * w_peak, "the default steps happen to hit the peak");
     assert!((found.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", found.lambda);
     assert!((found.value - a_peak).abs() < 1e-12 * a_peak, "{} vs {a_peak}", found.value);
-    assert!(found.solves < 40, "{} solves", found.solves);
+    // Three points of the bracket, the 65-point scan and a few Brent steps.
+    assert!(found.solves < 100, "{} solves", found.solves);
 }
 
 #[test]
