@@ -235,3 +235,32 @@ fn the_table_6_peak_at_1000_n_is_located_at_the_maximum_of_a_dense_grid() {
     assert!(best <= amplitude * (1.0 + 1e-9), "grid {best} above located {amplitude}");
     assert!(best >= amplitude * (1.0 - 1e-6), "grid {best} far below located {amplitude}");
 }
+
+#[test]
+fn table_6_crosses_20_to_2000_hz_at_3000_n_through_its_superharmonic_peak() {
+    // The third harmonic resonates near 72 Hz (3 × 72 Hz on the slipping resonance): a sharp
+    // peak where the secant predictor kept pointing off the curve and the branch stopped at
+    // 71.6 Hz. With default settings it now crosses the band.
+    let dir = scratch("wide-band");
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+        .unwrap()
+        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [3000.0]")
+        .replace("start_hz = 150.0", "start_hz = 20.0")
+        .replace("end_hz = 350.0", "end_hz = 2000.0")
+        .replace("time_data = 10", "time_data = \"none\"");
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-report", "--out"])
+        .arg(&dir)
+        .arg(dir.join("study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let c = columns(&dir.join("frf.csv"));
+    let (f, h1, h3) = (&c["frequency_Hz"], &c["mass_h1_amp_m"], &c["mass_h3_amp_m"]);
+    assert!((f[f.len() - 1] - 2000.0).abs() < 1e-9);
+    // Through the superharmonic peak: harmonic 3 there is above 10 % of harmonic 1.
+    let sup = (0..f.len()).filter(|&i| (60.0..85.0).contains(&f[i])).map(|i| h3[i] / h1[i]).fold(0.0, f64::max);
+    assert!(sup > 0.1, "h3/h1 = {sup} near 72 Hz");
+}

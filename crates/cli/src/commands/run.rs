@@ -138,10 +138,16 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .collect();
     let failed: Vec<String> = failed_snapshots.into_iter().filter_map(Result::err).map(|e| e.to_string()).collect();
     if !incomplete.is_empty() || !failed.is_empty() {
+        let mut what = Vec::new();
+        if !incomplete.is_empty() {
+            what.push(format!("{} level(s) did not cross the band (their points are written)", incomplete.len()));
+        }
+        if !failed.is_empty() {
+            what.push(format!("{} snapshot(s) failed", failed.len()));
+        }
         anyhow::bail!(
-            "{} level(s) did not cross the band (their points are written) and {} snapshot(s) failed:\n  {}",
-            incomplete.len(),
-            failed.len(),
+            "{}:\n  {}",
+            what.join(" and "),
             incomplete.iter().chain(&failed).cloned().collect::<Vec<_>>().join("\n  ")
         );
     }

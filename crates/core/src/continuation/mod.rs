@@ -33,6 +33,9 @@
 //!   default), the unit tangent, null vector of `[∂R/∂z]` ([`Predictor::Tangent`]), or the
 //!   paper's second-degree Lagrange polynomial through `z_{i−2}, z_{i−1}, z_i` parametrised by
 //!   their cumulative arclength (Eq. 31), evaluated at `s_i + h` ([`Predictor::Lagrange`]).
+//!   A secant or Lagrange prediction rejected twice in a row is retried along the tangent at
+//!   the last point (from the Jacobian there): at a sharp peak the curve turns within one
+//!   step, and the secant keeps pointing off it however short the step.
 //! - **CORRECT**: Newton on the bordered system (Eq. 32), the correction orthogonal to the
 //!   prediction direction `t = (z_p − z_i)/‖z_p − z_i‖`:
 //!

@@ -132,8 +132,8 @@ impl StepControl {
     ) -> Option<TerminationReason> {
         self.failed_iterations += iterations;
         self.attempts += 1;
-        self.step *= 0.5;
         self.just_rejected = true;
+        self.step *= 0.5;
         (self.step < options.min_step).then_some(TerminationReason::StepTooSmall {
             rejection,
             lambda: last_lambda,
@@ -263,14 +263,22 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let mut control =
             StepControl { step: options.initial_step, just_rejected: false, attempts: 0, failed_iterations: 0 };
         let mut furthest = 0.0;
+        // The tangent at the last point for a secant (or Lagrange) prediction that failed
+        // twice: computed once per point, on demand.
+        let mut fallback_tangent = None;
         loop {
             if points.len() >= options.max_points {
                 return TerminationReason::MaxPoints;
             }
             let last_lambda = points[points.len() - 1].lambda;
 
-            // PREDICT
-            self.predict(points, control.step);
+            // PREDICT. A secant rejected twice in a row at a sharp peak or a fold keeps
+            // pointing off the curve however short the step (the curve turns within one step);
+            // the tangent at the last point follows it.
+            if options.predictor != Predictor::Tangent && control.attempts >= 2 && fallback_tangent.is_none() {
+                fallback_tangent = Some(self.tangent_by_jacobian(&points[points.len() - 1]));
+            }
+            self.predict(points, control.step, fallback_tangent == Some(true));
 
             // CORRECT (Eq. 32)
             self.z.copy_from_slice(&self.z_pred);
@@ -376,6 +384,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             furthest = f64::max(furthest, fraction);
             observer.on_point(&point, furthest);
             points.push(point);
+            fallback_tangent = None;
 
             // ADAPT STEP
             control.accept(iterations, options);
@@ -397,13 +406,31 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         1.0
     }
 
-    /// PREDICT: fill `z_last`, `z_pred` and the unit prediction direction `t`.
-    fn predict(&mut self, points: &[Point], step: f64) {
+    /// The tangent at `last` from the Jacobian evaluated there, oriented along the previous
+    /// step (physical units, in `tangent`); false if it cannot be computed.
+    fn tangent_by_jacobian(&mut self, last: &Point) -> bool {
+        self.x_phys.copy_from_slice(&last.x);
+        if !matches!(self.evaluate(last.lambda, true), Ok(r) if r.is_finite()) {
+            return false;
+        }
+        self.reference.copy_from_slice(&self.previous_direction);
+        self.scale.direction_to_scaled(&mut self.reference);
+        if !self.tangent_at_last_point() {
+            return false;
+        }
+        self.scale.direction_to_physical(&mut self.tangent);
+        true
+    }
+
+    /// PREDICT: fill `z_last`, `z_pred` and the unit prediction direction `t`; along the
+    /// tangent at the last point when `along_tangent` (else the options' predictor).
+    fn predict(&mut self, points: &[Point], step: f64, along_tangent: bool) {
         let n = self.n;
         let count = points.len();
         let last = &points[count - 1];
         self.scale.to_scaled(&last.x, last.lambda, &mut self.z_last);
         let predictor = match (self.options.predictor, count) {
+            _ if along_tangent => Predictor::Tangent,
             (_, 1) | (Predictor::Tangent, _) => Predictor::Tangent,
             (Predictor::Lagrange, 3..) => Predictor::Lagrange,
             _ => Predictor::Secant,
