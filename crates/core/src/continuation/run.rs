@@ -675,7 +675,7 @@ mod tests {
         let line = |s: f64| point(0.1 + 0.6 * s, 0.2 + 0.8 * s);
         let points = [line(0.0), line(0.05), line(0.2)];
         let h = 0.07;
-        runner.predict(&points, h);
+        runner.predict(&points, h, false);
         let expected = line(0.2 + h);
         assert!((runner.z_pred[0] - expected.x[0]).abs() < 1e-15, "{:?}", runner.z_pred);
         assert!((runner.z_pred[1] - expected.lambda).abs() < 1e-15, "{:?}", runner.z_pred);
