@@ -264,3 +264,37 @@ fn table_6_crosses_20_to_2000_hz_at_3000_n_through_its_superharmonic_peak() {
     let sup = (0..f.len()).filter(|&i| (60.0..85.0).contains(&f[i])).map(|i| h3[i] / h1[i]).fold(0.0, f64::max);
     assert!(sup > 0.1, "h3/h1 = {sup} near 72 Hz");
 }
+
+#[test]
+fn an_undamped_sweep_started_on_a_natural_frequency_steps_off_it_and_says_so() {
+    // Without damping the flexibility H(kΩ) is infinite where kΩ meets ω_n = √(k/M): the
+    // condensed residual is not defined at that exact Ω. Started there (harmonic 1 on ω_n, and
+    // harmonic 3 on it), the branch starts 1e-6 of Ω off and crosses the band.
+    let wn_hz = (2.24e7f64 / 10.0).sqrt() / (2.0 * std::f64::consts::PI);
+    for start in [wn_hz, wn_hz / 3.0] {
+        let dir = scratch("undamped");
+        std::fs::create_dir_all(&dir).unwrap();
+        let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+            .unwrap()
+            .replace("alpha = 35.0", "alpha = 0.0")
+            .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
+            .replace("start_hz = 150.0", &format!("start_hz = {start:?}"))
+            .replace("time_data = 10", "time_data = \"none\"");
+        std::fs::write(dir.join("study.toml"), study).unwrap();
+        let out = stickslip()
+            .args(["run", "--quiet", "--no-report", "--out"])
+            .arg(&dir)
+            .arg(dir.join("study.toml"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
+        let c = columns(&dir.join("frf.csv"));
+        let f = &c["frequency_Hz"];
+        assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
+        // 1e-6 of Ω up the band (the start's value carries ~1e-16 of round-off).
+        let off = (f[0] - start) / start;
+        assert!((off - 1e-6).abs() < 1e-12, "started {off:e} off");
+        assert!(stderr.contains("meets a natural frequency of the undamped linear model"), "{stderr}");
+    }
+}

@@ -36,6 +36,8 @@ pub struct LevelRun {
     /// Total Newton iterations and residual evaluations over the sweep.
     pub newton_iterations: usize,
     pub evaluations: usize,
+    /// What the sweep did that the user should know (e.g. a start moved off a resonance).
+    pub note: Option<String>,
 }
 
 impl LevelRun {
@@ -97,7 +99,15 @@ pub fn run_level<O: Observer + ?Sized>(
         points.push(record(&result, p.iterations, residual, study.output_options.time_data.keeps(index)));
     }
     let peaks = locate_peaks(&mut hbm, &branch, level, &selectors, &points);
+    let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
+        format!(
+            "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
+            (p.lambda / TWO_PI - study.sweep.start_hz).abs(),
+            p.lambda / TWO_PI
+        )
+    });
     Ok(LevelRun {
+        note,
         newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
         evaluations: branch.calls.residuals,
         result: LevelResult { level_n: level, points, peaks },
@@ -331,7 +341,10 @@ pub fn report_data(
                 level_n: r.result.level_n,
                 points: r.result.points.len(),
                 complete: r.is_complete(),
-                ending: describe_termination(&r.termination),
+                ending: match &r.note {
+                    Some(note) => format!("{}; {note}", describe_termination(&r.termination)),
+                    None => describe_termination(&r.termination),
+                },
             })
             .collect(),
         peaks: peaks(&levels),

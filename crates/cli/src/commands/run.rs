@@ -72,6 +72,9 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
                 .with_context(|| format!("level {level} N"))?;
             let secs = level_started.elapsed().as_secs_f64();
+            if let Some(note) = &run.note {
+                bars.suspend(|| eprintln!("level {level} N: {note}"));
+            }
             bar.finish_with_message(format!(
                 "{} points, {}, {secs:.2} s",
                 run.result.points.len(),

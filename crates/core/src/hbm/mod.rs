@@ -11,4 +11,4 @@ pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
 pub use receptance::Receptance;
-pub use sweep::{sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};
+pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};

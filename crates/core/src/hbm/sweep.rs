@@ -79,6 +79,7 @@ pub fn sweep_frequency<O: Observer + ?Sized>(
     options: &Options,
     observer: &mut O,
 ) -> Result<Branch, SweepError> {
+    let omega_start = off_resonance(hbm, omega_start, omega_end, level)?;
     let guess = hbm.stuck_solution(omega_start, level)?;
     let branch =
         continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?;
@@ -96,6 +97,24 @@ pub fn sweep_frequency<O: Observer + ?Sized>(
         }
         _ => Ok(branch),
     }
+}
+
+/// `omega` itself if the balance can be evaluated there, else the nearest frequency towards
+/// `omega_toward` where it can (1e-6 to 1e-4 of `omega` away). Without damping the flexibility
+/// `H(kΩ)` is infinite where a harmonic kΩ meets a natural frequency: the condensed residual
+/// (a displacement) is not defined at that exact Ω, although the response through it is.
+pub fn off_resonance(hbm: &mut CondensedHbm<'_>, omega: f64, omega_toward: f64, level: f64) -> Result<f64, HbmError> {
+    let n = hbm.dimension();
+    let (zero, mut r) = (vec![0.0; n], vec![0.0; n]);
+    let direction = if omega_toward >= omega { 1.0 } else { -1.0 };
+    for shift in [0.0, 1e-6, 1e-5, 1e-4] {
+        let w = omega * (1.0 + direction * shift);
+        hbm.evaluate(&zero, w, level, &mut r, None)?;
+        if r.iter().all(|v| v.is_finite()) {
+            return Ok(w);
+        }
+    }
+    Ok(omega)
 }
 
 /// Continue the periodic response at frequency `omega` (rad/s) in the force level from
