@@ -30,17 +30,21 @@ impl PyParamDesign {
     #[new]
     #[pyo3(signature = (study, varies, samples=None, seed=0))]
     fn new(study: &Bound<'_, PyAny>, varies: Vec<String>, samples: Option<usize>, seed: u64) -> PyResult<Self> {
-        // A Study, or a dict shaped like a study file.
-        let (table, path) = match study.cast::<PyStudy>() {
-            Ok(s) => {
-                let s = s.get();
-                (s.table.clone(), s.study.path.clone())
-            }
-            Err(_) => (table_from_dict(study, "")?, std::path::PathBuf::from("<dict>")),
-        };
+        let (table, path) = table_and_path(study)?;
         guarded(|| {
             let varies = varies.iter().map(|v| Vary::parse(v)).collect::<Result<Vec<_>, _>>().map_err(param_error)?;
             let inner = ParamStudy::new(table, path, &varies, samples, seed).map_err(param_error)?;
+            Ok(PyParamDesign { inner })
+        })
+    }
+
+    /// A design given sample by sample: `samples[i][k]` is the value of `keys[k]` in sample
+    /// `i`. The keys are checked now; a sample the study refuses fails alone when it runs.
+    #[staticmethod]
+    fn from_samples(study: &Bound<'_, PyAny>, keys: Vec<String>, samples: Vec<Vec<f64>>) -> PyResult<Self> {
+        let (table, path) = table_and_path(study)?;
+        guarded(|| {
+            let inner = ParamStudy::with_samples(table, path, &keys, samples).map_err(param_error)?;
             Ok(PyParamDesign { inner })
         })
     }
@@ -106,6 +110,17 @@ impl PyParamDesign {
 
     fn __len__(&self) -> usize {
         self.inner.samples.len()
+    }
+}
+
+/// A Study, or a dict shaped like a study file.
+fn table_and_path(study: &Bound<'_, PyAny>) -> PyResult<(toml::Table, std::path::PathBuf)> {
+    match study.cast::<PyStudy>() {
+        Ok(s) => {
+            let s = s.get();
+            Ok((s.table.clone(), s.study.path.clone()))
+        }
+        Err(_) => Ok((table_from_dict(study, "")?, std::path::PathBuf::from("<dict>"))),
     }
 }
 

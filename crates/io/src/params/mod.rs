@@ -141,6 +141,37 @@ impl ParamStudy {
         Ok(ParamStudy { base, path, keys, kinds, samples, method: d.method })
     }
 
+    /// A study run at samples given value by value (a design made elsewhere): the keys are
+    /// checked as in [`ParamStudy::new`]; a sample whose values the study refuses is recorded
+    /// as failed when it runs, with the study's message, and the others go on.
+    pub fn with_samples(
+        base: toml::Table,
+        path: impl AsRef<Path>,
+        keys: &[String],
+        samples: Vec<Vec<f64>>,
+    ) -> Result<Self, ParamError> {
+        let path = path.as_ref().to_path_buf();
+        Study::from_table(&base, &path)?;
+        let mut parsed = Vec::new();
+        let mut kinds = Vec::new();
+        for k in keys {
+            let key = KeyPath::parse(k)?;
+            if parsed.contains(&key) {
+                return Err(ParamError::Key { key: k.clone(), message: "is varied twice".into() });
+            }
+            kinds.push(key.kind(&base)?);
+            parsed.push(key);
+        }
+        if let Some((i, row)) = samples.iter().enumerate().find(|(_, r)| r.len() != keys.len()) {
+            return Err(ParamError::Design(format!(
+                "sample {i} has {} value(s), expected {} (one per key)",
+                row.len(),
+                keys.len()
+            )));
+        }
+        Ok(ParamStudy { base, path, keys: parsed, kinds, samples, method: "given samples".into() })
+    }
+
     /// An identifier of the study without its samples' values (its table, written out, and
     /// the folder its relative paths resolve against): finished samples stored under another
     /// identifier belong to another study and are never mixed with this one's.
