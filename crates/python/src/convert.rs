@@ -9,9 +9,24 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use toml::{Table, Value};
 
 pyo3::create_exception!(_stickslip, Error, PyException, "Base class of every stickslip error.");
-pyo3::create_exception!(_stickslip, StudyError, Error, "A study that does not validate or whose model cannot be built.");
-pyo3::create_exception!(_stickslip, SolveError, Error, "The harmonic balance, the time integration or a signal analysis failed.");
-pyo3::create_exception!(_stickslip, ParamError, Error, "A parameter study that cannot be set up: key, range, design, files.");
+pyo3::create_exception!(
+    _stickslip,
+    StudyError,
+    Error,
+    "A study that does not validate or whose model cannot be built."
+);
+pyo3::create_exception!(
+    _stickslip,
+    SolveError,
+    Error,
+    "The harmonic balance, the time integration or a signal analysis failed."
+);
+pyo3::create_exception!(
+    _stickslip,
+    ParamError,
+    Error,
+    "A parameter study that cannot be set up: key, range, design, files."
+);
 pyo3::create_exception!(_stickslip, InputError, Error, "An argument of the wrong type, shape or value.");
 
 /// An error and its causes, as the command line prints them (`a: b: c`).

@@ -126,7 +126,10 @@ fn table_and_path(study: &Bound<'_, PyAny>) -> PyResult<(toml::Table, std::path:
 
 impl PyParamDesign {
     fn out_of_range(&self, index: usize) -> PyErr {
-        ParamError::new_err(format!("sample {index} does not exist: the design has {} samples", self.inner.samples.len()))
+        ParamError::new_err(format!(
+            "sample {index} does not exist: the design has {} samples",
+            self.inner.samples.len()
+        ))
     }
 }
 

@@ -135,7 +135,8 @@ impl PyStudy {
         let solved = py.detach(|| {
             guarded(|| {
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
-                let mut o = SteadyStateOptions::new(frequency_hz, excitation.pattern.iter().map(|p| p * level_n).collect());
+                let mut o =
+                    SteadyStateOptions::new(frequency_hz, excitation.pattern.iter().map(|p| p * level_n).collect());
                 o.steps_per_period = steps_per_period;
                 o.harmonics = study.hbm.harmonics;
                 o.tolerance = tolerance;

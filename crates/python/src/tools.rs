@@ -96,11 +96,14 @@ pub fn extract<'py>(
     let reference = vector(reference, "reference")?.as_array().to_vec();
     let mut channels: Vec<(String, Vec<f64>)> = Vec::new();
     for (name, samples) in responses.iter() {
-        let name: String = name.extract().map_err(|_| InputError::new_err("responses: keys must be channel names (str)"))?;
+        let name: String =
+            name.extract().map_err(|_| InputError::new_err("responses: keys must be channel names (str)"))?;
         let v = vector(&samples, &format!("responses[{name:?}]"))?.as_array().to_vec();
         channels.push((name, v));
     }
-    for (name, v) in std::iter::once(("reference".to_string(), &reference)).chain(channels.iter().map(|(n, v)| (n.clone(), v))) {
+    for (name, v) in
+        std::iter::once(("reference".to_string(), &reference)).chain(channels.iter().map(|(n, v)| (n.clone(), v)))
+    {
         if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
             return Err(InputError::new_err(format!("{name}: sample {i} is {x}, not a finite number")));
         }
@@ -113,7 +116,8 @@ pub fn extract<'py>(
         })
     })?;
     let d = PyDict::new(py);
-    let column = |f: &dyn Fn(&stickslip_core::signal::harmonics::Block) -> f64| -> Vec<f64> { blocks.iter().map(f).collect() };
+    let column =
+        |f: &dyn Fn(&stickslip_core::signal::harmonics::Block) -> f64| -> Vec<f64> { blocks.iter().map(f).collect() };
     d.set_item("frequency_hz", PyArray1::from_vec(py, column(&|b| b.frequency_hz)))?;
     d.set_item("start_s", PyArray1::from_vec(py, column(&|b| b.start_s)))?;
     d.set_item("end_s", PyArray1::from_vec(py, column(&|b| b.end_s)))?;

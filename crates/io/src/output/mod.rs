@@ -99,7 +99,11 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 /// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`]. Returns the
 /// paths of the FRF table, the NPZ file and the plots.
 #[cfg(feature = "plot")]
-pub fn write_results(dir: &std::path::Path, levels: &[LevelResult], plot_format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+pub fn write_results(
+    dir: &std::path::Path,
+    levels: &[LevelResult],
+    plot_format: PlotFormat,
+) -> Result<Vec<PathBuf>, OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
     write_frf_csv(&csv, levels)?;

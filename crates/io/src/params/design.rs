@@ -39,28 +39,27 @@ impl Vary {
             }
             Ok(x)
         };
-        let values = if spec.contains(':') {
-            let parts: Vec<&str> = spec.split(':').collect();
-            let (low, high) = (number(parts[0])?, number(parts[1])?);
-            if low >= high {
-                return Err(spec_error(format!("the range {low}:{high} is empty: LO must be below HI")));
-            }
-            match parts.len() {
-                2 => Values::Range { low, high },
-                3 => {
-                    let count = parts[2]
-                        .trim()
-                        .parse::<usize>()
-                        .ok()
-                        .filter(|n| *n >= 2)
-                        .ok_or_else(|| spec_error(format!("N = `{}` must be an integer >= 2", parts[2].trim())))?;
-                    Values::Spaced { low, high, count }
+        let values =
+            if spec.contains(':') {
+                let parts: Vec<&str> = spec.split(':').collect();
+                let (low, high) = (number(parts[0])?, number(parts[1])?);
+                if low >= high {
+                    return Err(spec_error(format!("the range {low}:{high} is empty: LO must be below HI")));
                 }
-                _ => return Err(spec_error("expected LO:HI or LO:HI:N".into())),
-            }
-        } else {
-            Values::List(spec.split(',').map(number).collect::<Result<_, _>>()?)
-        };
+                match parts.len() {
+                    2 => Values::Range { low, high },
+                    3 => {
+                        let count =
+                            parts[2].trim().parse::<usize>().ok().filter(|n| *n >= 2).ok_or_else(|| {
+                                spec_error(format!("N = `{}` must be an integer >= 2", parts[2].trim()))
+                            })?;
+                        Values::Spaced { low, high, count }
+                    }
+                    _ => return Err(spec_error("expected LO:HI or LO:HI:N".into())),
+                }
+            } else {
+                Values::List(spec.split(',').map(number).collect::<Result<_, _>>()?)
+            };
         Ok(Vary { key: key.to_string(), values })
     }
 
@@ -105,7 +104,10 @@ pub fn design(varies: &[Vary], samples: Option<usize>, seed: u64) -> Result<Desi
                 _ => unreachable!("all keys are ranges"),
             })
             .collect();
-        return Ok(Design { samples: latin_hypercube(&bounds, n, seed), method: format!("Latin hypercube, seed {seed}") });
+        return Ok(Design {
+            samples: latin_hypercube(&bounds, n, seed),
+            method: format!("Latin hypercube, seed {seed}"),
+        });
     }
     if let Some(n) = samples {
         return Err(ParamError::Design(format!(

@@ -16,16 +16,8 @@ use std::path::{Path, PathBuf};
 use super::{fnv1a, ParamError, ParamStudy, SampleOutcome};
 
 /// Summary columns after `sample` and the varied keys (units in the names, Hz for frequencies).
-pub const SUMMARY_COLUMNS: [&str; 8] = [
-    "level_N",
-    "peak_frequency_Hz",
-    "peak_amplitude_m",
-    "peak_energy_J",
-    "points",
-    "complete",
-    "ending",
-    "error",
-];
+pub const SUMMARY_COLUMNS: [&str; 8] =
+    ["level_N", "peak_frequency_Hz", "peak_amplitude_m", "peak_energy_J", "points", "complete", "ending", "error"];
 
 /// Shard `index` (from 1) of `count`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,7 +31,8 @@ impl Shard {
     pub fn parse(text: &str) -> Result<Shard, ParamError> {
         let bad = || ParamError::Design(format!("--shard {text}: expected I/N with 1 <= I <= N, e.g. 3/10"));
         let (i, n) = text.split_once('/').ok_or_else(bad)?;
-        let (index, count) = (i.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
+        let (index, count) =
+            (i.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
         if index == 0 || index > count {
             return Err(bad());
         }
@@ -120,7 +113,12 @@ fn comment(study: &ParamStudy, shard: Option<Shard>) -> String {
 }
 
 /// Write the table of one shard (its outcomes in sample order) into `dir`.
-pub fn write_shard(dir: &Path, study: &ParamStudy, shard: Shard, outcomes: &[SampleOutcome]) -> Result<PathBuf, ParamError> {
+pub fn write_shard(
+    dir: &Path,
+    study: &ParamStudy,
+    shard: Shard,
+    outcomes: &[SampleOutcome],
+) -> Result<PathBuf, ParamError> {
     let mut text = comment(study, Some(shard));
     text.push('\n');
     text.push_str(&header(study));
@@ -146,7 +144,8 @@ pub fn write_curves(dir: &Path, outcome: &SampleOutcome) -> Result<Option<PathBu
 }
 
 fn write(path: &Path, text: &str) -> Result<(), ParamError> {
-    std::fs::write(path, text).map_err(|e| ParamError::File { path: path.to_path_buf(), message: format!("cannot write: {e}") })
+    std::fs::write(path, text)
+        .map_err(|e| ParamError::File { path: path.to_path_buf(), message: format!("cannot write: {e}") })
 }
 
 /// One shard file read back.
@@ -195,10 +194,8 @@ pub fn merge(dir: &Path) -> Result<(PathBuf, usize), ParamError> {
         }
         present[s.shard.index - 1] = true;
     }
-    let missing: Vec<String> = (1..=count)
-        .filter(|i| !present[i - 1])
-        .map(|i| Shard { index: i, count }.file_name())
-        .collect();
+    let missing: Vec<String> =
+        (1..=count).filter(|i| !present[i - 1]).map(|i| Shard { index: i, count }.file_name()).collect();
     if !missing.is_empty() {
         return Err(ParamError::File {
             path: dir.to_path_buf(),
@@ -235,7 +232,9 @@ fn read_shard(path: &Path) -> Result<ShardFile, ParamError> {
             .split_whitespace()
             .find_map(|w| w.strip_prefix(name).and_then(|w| w.strip_prefix('=')))
             .map(str::to_string)
-            .ok_or_else(|| bad(format!("the first line must be `# study=... design=... shard=I/N samples=...`, got {first:?}")))
+            .ok_or_else(|| {
+                bad(format!("the first line must be `# study=... design=... shard=I/N samples=...`, got {first:?}"))
+            })
     };
     let (study, design) = (field("study")?, field("design")?);
     let shard = Shard::parse(&field("shard")?)?;

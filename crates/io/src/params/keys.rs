@@ -80,11 +80,9 @@ impl KeyPath {
         match self.locate(table)? {
             Some(Value::Float(_)) => Ok(NumberKind::Float),
             Some(Value::Integer(_)) => Ok(NumberKind::Integer),
-            Some(other) => Err(self.error(format!(
-                "holds {} {}, not a number: only numeric values can be varied",
-                article(other.type_str()),
-                other
-            ))),
+            Some(other) => {
+                Err(self.error(format!("holds {}, not a number: only numeric values can be varied", described(other))))
+            }
             None => Ok(NumberKind::Float),
         }
     }
@@ -109,12 +107,8 @@ impl KeyPath {
                     Ok(())
                 }
                 (Segment::Index(i), Value::Array(a)) => Err(self.out_of_range(*i, a.len())),
-                (Segment::Key(k), other) => {
-                    Err(self.error(format!("`{k}` is looked up in {} {other}", article(other.type_str()))))
-                }
-                (Segment::Index(i), other) => {
-                    Err(self.error(format!("[{i}] is looked up in {} {other}", article(other.type_str()))))
-                }
+                (Segment::Key(k), other) => Err(self.error(format!("`{k}` is looked up in {}", described(other)))),
+                (Segment::Index(i), other) => Err(self.error(format!("[{i}] is looked up in {}", described(other)))),
             }
         })();
         let Value::Table(t) = here else { unreachable!("the root stays a table") };
@@ -183,15 +177,13 @@ impl KeyPath {
                 }
             },
             (Segment::Index(i), Value::Array(a)) => a.get(*i).map(Some).ok_or_else(|| self.out_of_range(*i, a.len())),
-            (Segment::Key(k), other) => Err(self.error(format!(
-                "`{}` is {} {other}, which has no key `{k}`",
-                self.prefix(depth),
-                article(other.type_str())
-            ))),
+            (Segment::Key(k), other) => {
+                Err(self.error(format!("`{}` is {}, which has no key `{k}`", self.prefix(depth), described(other))))
+            }
             (Segment::Index(i), other) => Err(self.error(format!(
-                "`{}` is {} {other}, not a list: [{i}] does not apply",
+                "`{}` is {}, not a list: [{i}] does not apply",
                 self.prefix(depth),
-                article(other.type_str())
+                described(other)
             ))),
         }
     }
@@ -218,7 +210,9 @@ impl KeyPath {
             Segment::Index(i) => format!("[{i}]"),
         };
         let at = if depth == 0 { "the study".to_string() } else { format!("`{}`", self.prefix(depth)) };
-        self.error(format!("{at} has no {what}; only values the study sets (or keys of a section it has) can be varied"))
+        self.error(format!(
+            "{at} has no {what}; only values the study sets (or keys of a section it has) can be varied"
+        ))
     }
 
     fn out_of_range(&self, index: usize, len: usize) -> ParamError {
@@ -240,9 +234,15 @@ fn named(a: &[Value], name: &str) -> Option<usize> {
     a.iter().position(|v| v.get("name").and_then(Value::as_str) == Some(name))
 }
 
-fn article(type_str: &str) -> &'static str {
-    match type_str.chars().next() {
-        Some('a' | 'e' | 'i' | 'o' | 'u') => "an",
-        _ => "a",
+/// `a string "M"`, `an array [1, 2]`: a value with its type, for messages.
+fn described(v: &Value) -> String {
+    let t = v.type_str();
+    let article = if t.starts_with(['a', 'e', 'i', 'o', 'u']) { "an" } else { "a" };
+    let text = v.to_string();
+    // A whole table would be long: its type says enough.
+    if matches!(v, Value::Table(_)) || text.len() > 60 {
+        format!("{article} {t}")
+    } else {
+        format!("{article} {t} {text}")
     }
 }

@@ -87,10 +87,17 @@ pub struct SampleOutcome {
 
 impl ParamStudy {
     /// Read a study file and set up its samples.
-    pub fn load(path: impl AsRef<Path>, varies: &[Vary], samples: Option<usize>, seed: u64) -> Result<Self, ParamError> {
+    pub fn load(
+        path: impl AsRef<Path>,
+        varies: &[Vary],
+        samples: Option<usize>,
+        seed: u64,
+    ) -> Result<Self, ParamError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ParamError::File { path: path.to_path_buf(), message: format!("cannot read the file: {e}") })?;
+        let text = std::fs::read_to_string(path).map_err(|e| ParamError::File {
+            path: path.to_path_buf(),
+            message: format!("cannot read the file: {e}"),
+        })?;
         // The file is validated as a file first, so that its errors carry line and column.
         Study::parse(&text, path)?;
         let base: toml::Table = toml::from_str(&text).expect("a study that validates is a TOML table");
@@ -248,10 +255,8 @@ fn run_table(
 /// The peak of output `which`'s first harmonic over a level's points.
 pub fn summarise(level: &LevelResult, which: usize, complete: bool, ending: String) -> SummaryRow {
     let amplitude = |p: &crate::output::PointRecord| p.outputs.get(which).map_or(f64::NAN, |o| o.harmonics[1].0);
-    let peak = level
-        .points
-        .iter()
-        .max_by(|a, b| amplitude(a).partial_cmp(&amplitude(b)).unwrap_or(std::cmp::Ordering::Equal));
+    let peak =
+        level.points.iter().max_by(|a, b| amplitude(a).partial_cmp(&amplitude(b)).unwrap_or(std::cmp::Ordering::Equal));
     SummaryRow {
         level_n: level.level_n,
         peak_frequency_hz: peak.map_or(f64::NAN, |p| p.frequency_hz),

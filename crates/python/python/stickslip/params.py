@@ -185,6 +185,10 @@ class ParamResults:
             frame[c] = frame[c].astype(float)
         frame["points"] = frame["points"].astype("int64")
         frame["complete"] = frame["complete"].astype(bool)
+        # Text columns as Python objects (None where there is no error) whatever the pandas
+        # version's default string type: tables from different runs compare equal.
+        for c in ("ending", "error"):
+            frame[c] = pd.Series([None if v is None or v != v else str(v) for v in frame[c]], dtype=object)
         return frame
 
     def to_xarray(self):
@@ -203,7 +207,9 @@ class ParamResults:
             raise ParamError(f"sample {sample} has no curves: run with curves=True"
                              + (f" (it failed: {o['error']})" if o["error"] else ""))
         columns, table = o["curves"]
-        return pd.DataFrame(table, columns=list(columns))
+        frame = pd.DataFrame(table, columns=[str(c) for c in columns])
+        frame["newton_iterations"] = frame["newton_iterations"].astype("int64")
+        return frame
 
     @property
     def failed(self) -> list:
