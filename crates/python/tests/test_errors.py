@@ -55,7 +55,9 @@ def test_a_bad_file_raises_the_cli_message(cli, tmp_path):
         stickslip.Study.from_toml(path)
     # The command prints `error: <message>`; the exception carries the message itself.
     assert p.stderr.strip() == f"error: {e.value}"
-    assert str(e.value) == f'{path}:17:13: [[joint]] "joint": threshold must be > 0 N, got -3'
+    # The file's line and column of the value.
+    line = path.read_text().splitlines().index("threshold = -3.0") + 1
+    assert str(e.value) == f'{path}:{line}:13: [[joint]] "joint": threshold must be > 0 N, got -3'
 
 
 def test_a_bad_dict_raises_the_same_message_without_a_line():
