@@ -29,6 +29,9 @@ fn vector<'py>(a: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArray1<'
     })
 }
 
+/// Frequencies (Hz) and mode shapes (one column per mode).
+type FrequenciesAndShapes<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// Undamped modes of `(K, M)` by a dense generalised symmetric eigensolution (for small or
 /// reduced models): returns `(frequencies_hz, shapes)` with shapes mass-normalised, one column
 /// per mode, lowest first; `count` keeps the lowest `count` modes.
@@ -39,7 +42,7 @@ pub fn modes<'py>(
     mass: &Bound<'py, PyAny>,
     stiffness: &Bound<'py, PyAny>,
     count: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<FrequenciesAndShapes<'py>> {
     let (m, k) = (matrix(mass, "mass")?, matrix(stiffness, "stiffness")?);
     let n = m.shape()[0];
     for (name, a) in [("mass", &m), ("stiffness", &k)] {
