@@ -28,7 +28,7 @@ def main():
     for level, points in frame.groupby("level_N"):
         peak = points.loc[points["mass_h1_amp_m"].idxmax()]
         print(f"  {level:7.0f} N: peak {peak['mass_h1_amp_m']:.3e} m at {peak['frequency_Hz']:.1f} Hz, "
-              f"joint dissipates {peak['joint_energy_J']:.3e} J/cycle, stuck {peak['joint_stick_fraction']:.0%} of it")
+              f"joint dissipates {peak['joint_energy_J']:.3e} J/cycle, stuck {peak['joint_stick_fraction']:.0%} of the period")
 
     # 2. The same study built from a dict (here: the file's, at the paper's 1000 N only).
     d = study.to_dict()
@@ -43,7 +43,7 @@ def main():
         samples=40, seed=1, scheduler="processes", workers=2,
     ).to_pandas()
     print(table[["joint.joint.threshold", "damping.alpha", "peak_frequency_Hz", "peak_amplitude_m",
-                 "peak_energy_J"]].describe().loc[["min", "mean", "max"]])
+                 "peak_energy_J"]].describe().loc[["min", "mean", "max"]].to_string())
 
 
 # Local processes start fresh interpreters that import this file: the work runs only when it
