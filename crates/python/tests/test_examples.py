@@ -74,3 +74,23 @@ def test_progress_reaches_the_end_of_every_level(root):
         assert fraction == pytest.approx(1.0, abs=1e-12)
         assert hz == pytest.approx(350.0, rel=1e-9)
     assert results.complete
+
+
+def test_a_study_pickles_to_the_same_results(root):
+    import pickle
+
+    study = stickslip.Study.from_toml(root / "examples" / "jenkins-2dof" / "study.toml")
+    copy = pickle.loads(pickle.dumps(study))
+    assert copy.path == study.path
+    # The same study rebuilt from its dict: bit-identical results.
+    assert np.array_equal(copy.run().table, study.run().table)
+
+
+def test_an_exception_in_the_progress_callback_reaches_the_caller(root):
+    study = stickslip.Study.from_toml(root / "examples" / "jenkins-1dof" / "study.toml")
+
+    def progress(level, fraction, hz):
+        raise RuntimeError(f"stop at {level} N")
+
+    with pytest.raises(RuntimeError, match="stop at 100.0 N"):
+        study.run(progress=progress)
