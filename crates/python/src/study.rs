@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_core::timesim::{steady_state, SteadyStateOptions};
 use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
@@ -74,7 +75,7 @@ impl PyStudy {
         self.study.excitation.levels.clone()
     }
 
-    /// Sweep the band at every force level (in order, one after the other). `progress`, if
+    /// Sweep the band at every force level (in parallel, as the command line). `progress`, if
     /// given, is called as `progress(level_n, fraction_done, frequency_hz)` after each
     /// converged point. Returns a dict: `columns` (those of `frf.csv`), `table` (one row per
     /// point, all levels), `levels` (per level: `level_N`, `points`, `complete`, `ending`,
@@ -87,24 +88,27 @@ impl PyStudy {
         let runs = py.detach(|| {
             guarded(|| {
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
-                let mut runs: Vec<LevelRun> = Vec::new();
-                for &level in &excitation.levels_n {
-                    let mut observer = |p: &Point, done: f64| {
-                        let Some(cb) = &progress else { return };
-                        let mut failed = callback_error.lock().unwrap_or_else(|e| e.into_inner());
-                        if failed.is_some() {
-                            return;
-                        }
-                        let hz = p.lambda / (2.0 * std::f64::consts::PI);
-                        if let Err(e) = Python::attach(|py| cb.call1(py, (level, done, hz)).map(|_| ())) {
-                            *failed = Some(e);
-                        }
-                    };
-                    let run = run_level(study, &model, &excitation, &outputs, level, &mut observer)
-                        .map_err(|e| SolveError::new_err(format!("level {level} N: {}", chain(&e))))?;
-                    runs.push(run);
-                }
-                Ok(runs)
+                // Levels are independent sweeps: solved in parallel on the thread pool, as the
+                // command line does, and returned in the study's order.
+                excitation
+                    .levels_n
+                    .par_iter()
+                    .map(|&level| {
+                        let mut observer = |p: &Point, done: f64| {
+                            let Some(cb) = &progress else { return };
+                            let mut failed = callback_error.lock().unwrap_or_else(|e| e.into_inner());
+                            if failed.is_some() {
+                                return;
+                            }
+                            let hz = p.lambda / (2.0 * std::f64::consts::PI);
+                            if let Err(e) = Python::attach(|py| cb.call1(py, (level, done, hz)).map(|_| ())) {
+                                *failed = Some(e);
+                            }
+                        };
+                        run_level(study, &model, &excitation, &outputs, level, &mut observer)
+                            .map_err(|e| SolveError::new_err(format!("level {level} N: {}", chain(&e))))
+                    })
+                    .collect::<PyResult<Vec<LevelRun>>>()
             })
         })?;
         if let Some(e) = callback_error.into_inner().unwrap_or_else(|e| e.into_inner()) {

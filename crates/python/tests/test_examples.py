@@ -92,5 +92,6 @@ def test_an_exception_in_the_progress_callback_reaches_the_caller(root):
     def progress(level, fraction, hz):
         raise RuntimeError(f"stop at {level} N")
 
-    with pytest.raises(RuntimeError, match="stop at 100.0 N"):
+    # Levels run in parallel: whichever level calls first raises.
+    with pytest.raises(RuntimeError, match=r"stop at \d+\.0 N"):
         study.run(progress=progress)

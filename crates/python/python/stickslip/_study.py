@@ -46,7 +46,7 @@ class Study:
         return self._native.levels
 
     def run(self, progress=None, strict: bool = False) -> "Results":
-        """Sweep the band at every force level. ``progress(level_n, fraction_done,
+        """Sweep the band at every force level (levels in parallel). ``progress(level_n, fraction_done,
         frequency_hz)`` is called after each converged point (e.g. to move a tqdm bar). A
         level whose branch does not cross the band is kept and marked (``Results.levels``);
         with ``strict=True`` it raises :class:`SolveError` as the command line does."""
