@@ -33,6 +33,10 @@ enum Command {
     Extract(commands::extract::Args),
     /// Measured against simulated FRFs: overlay plots, peak frequencies and amplitudes.
     Compare(commands::compare::Args),
+    /// A parameter study (grid or Latin hypercube over study values), whole or one shard.
+    Params(commands::params::Args),
+    /// Merge the shard tables of a parameter study into samples.csv.
+    Merge(commands::params::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +58,8 @@ fn main() -> ExitCode {
         Command::Timesim(a) => commands::timesim::main(a),
         Command::Extract(a) => commands::extract::main(a),
         Command::Compare(a) => commands::compare::main(a),
+        Command::Params(a) => commands::params::main(a),
+        Command::Merge(a) => commands::params::merge_main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,8 @@
 pub mod analysis;
 pub mod matrix;
 pub mod output;
+pub mod params;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod records;
 pub mod report;

@@ -24,7 +24,7 @@ pub fn frf_columns(template: &PointRecord) -> Vec<String> {
 }
 
 /// The numbers of one row of `frf.csv`, in the order of [`frf_columns`].
-pub(crate) fn frf_row(level_n: f64, p: &PointRecord) -> Vec<f64> {
+pub fn frf_row(level_n: f64, p: &PointRecord) -> Vec<f64> {
     let mut row = vec![level_n, p.frequency_hz, p.iterations as f64, p.residual];
     for o in &p.outputs {
         row.extend([o.disp_frf, o.accel_frf, o.peak]);

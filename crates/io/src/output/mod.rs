@@ -9,11 +9,16 @@
 mod csv;
 mod npz;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
+#[cfg(feature = "plot")]
 use crate::study::PlotFormat;
+#[cfg(feature = "plot")]
+use std::path::Path;
 
-pub use csv::{frf_columns, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv, write_time_data};
+pub use csv::{
+    frf_columns, frf_row, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv, write_time_data,
+};
 pub use npz::write_frf_npz;
 
 /// All converged points of one force level.
@@ -140,7 +145,12 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 /// time data of the points that carry it (`points/`), and one FRF plot per output
 /// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`]. Returns the
 /// paths of the FRF table, the NPZ file and the plots.
-pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+#[cfg(feature = "plot")]
+pub fn write_results(
+    dir: &std::path::Path,
+    levels: &[LevelResult],
+    plot_format: PlotFormat,
+) -> Result<Vec<PathBuf>, OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
     write_frf_csv(&csv, levels)?;
@@ -157,6 +167,7 @@ pub fn write_results(dir: &Path, levels: &[LevelResult], plot_format: PlotFormat
 /// Write each snapshot's time signals, `snapshot<i>.csv` (i from 0, in the study's order), and
 /// per joint with both sides known the plot of their velocities, `snapshot<i>_<joint>.<ext>`.
 /// Returns the files written.
+#[cfg(feature = "plot")]
 pub fn write_snapshots(
     dir: &Path,
     snapshots: &[SnapshotResult],

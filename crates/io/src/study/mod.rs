@@ -430,4 +430,19 @@ impl Study {
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Study, StudyError> {
         validate::parse(text, path.as_ref())
     }
+
+    /// Validate a study given as a table (e.g. a Python dict) rather than as text: the table
+    /// is written as TOML and goes through [`Study::parse`], so the checks and their messages
+    /// are those of a file. `path` names the study in errors and anchors its relative paths;
+    /// errors carry no line and column, which the table does not have (the message names the
+    /// section and the key).
+    pub fn from_table(table: &toml::Table, path: impl AsRef<Path>) -> Result<Study, StudyError> {
+        let path = path.as_ref();
+        let text = toml::to_string(table).map_err(|e| StudyError {
+            file: path.to_path_buf(),
+            location: None,
+            kind: Box::new(StudyErrorKind::Syntax(e.to_string())),
+        })?;
+        Study::parse(&text, path).map_err(|e| StudyError { location: None, ..e })
+    }
 }
