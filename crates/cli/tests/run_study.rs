@@ -26,6 +26,10 @@ fn the_1dof_example_writes_an_frf_table_covering_the_band_at_every_level() {
     let (header, rows, out) = run_example("jenkins-1dof");
     assert_eq!(&header[..2], &["level_N", "frequency_Hz"]);
     let accel = header.iter().position(|h| h == "mass_accel_frf_m_s2_per_N").expect("acceleration FRF column");
+    // residual_rel is the measure Newton's tolerance (default 1e-8) applies to.
+    let residual = header.iter().position(|h| h == "residual_rel").unwrap();
+    assert!(rows.iter().all(|r| r[residual] <= 1e-8), "a residual above the tolerance");
+    assert!(rows.iter().any(|r| r[residual] > 1e-12), "residuals all round-off: not the tolerance's measure?");
     for level in [100.0, 1000.0, 3000.0, 10000.0] {
         let f: Vec<f64> = rows.iter().filter(|r| r[0] == level).map(|r| r[1]).collect();
         assert!(f.len() > 20, "level {level}: {} points", f.len());

@@ -94,8 +94,8 @@ pub fn run_level<O: Observer + ?Sized>(
     let mut points = Vec::with_capacity(branch.points.len());
     for (index, p) in branch.points.iter().enumerate() {
         let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
-        let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let residual = p.residual_norm / x_norm.max(f64::MIN_POSITIVE);
+        // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
+        let residual = p.residual_norm / branch.residual_scale;
         points.push(record(&result, p.iterations, residual, study.output_options.time_data.keeps(index)));
     }
     let peaks = locate_peaks(&mut hbm, &branch, level, &selectors, &points);
@@ -217,8 +217,7 @@ pub fn run_snapshot(
     let selectors: Vec<OutputSelector> =
         outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
     let result = evaluate_point(&mut hbm, &p.x, omega, snapshot.level, &selectors).map_err(SweepError::from)?;
-    let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let point = record(&result, p.iterations, p.residual_norm / x_norm.max(f64::MIN_POSITIVE), true);
+    let point = record(&result, p.iterations, p.residual_norm / branch.residual_scale, true);
     let sides = study
         .joints
         .iter()

@@ -369,6 +369,10 @@ pub struct Branch {
     pub termination: TerminationReason,
     /// All calls, rejected attempts included.
     pub calls: Calls,
+    /// The residual scale `s_R` (see "Scaled variables"): Newton converges when
+    /// `‖R‖ ≤ max(rtol s_R, atol)`, so `Point::residual_norm / residual_scale` is the measure the
+    /// tolerance applies to.
+    pub residual_scale: f64,
 }
 
 /// Receives every converged point as it is accepted.
