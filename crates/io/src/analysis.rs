@@ -280,10 +280,18 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     ),
                 ),
             };
-            let placement = match &j.placement {
+            let describe = |p: &Placement| match p {
                 Placement::Dof(d) => format!("DOF {d} and the ground"),
                 Placement::Between(a, b) => format!("DOFs {a} and {b}"),
                 Placement::Vector(_) => "a vector over the DOFs".to_string(),
+            };
+            let placement = match &j.law {
+                LawSpec::Contact { tangential, normal, .. } => format!(
+                    "tangential {}; normal {}",
+                    tangential.iter().map(describe).collect::<Vec<_>>().join(", "),
+                    describe(normal)
+                ),
+                _ => describe(&j.placement),
             };
             JointSummary { name: j.name.clone(), placement, law: law.to_string(), parameters }
         })
