@@ -16,7 +16,8 @@ use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
 };
 use crate::study::{
-    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod, Study,
+    self, ContactSpec, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement,
+    ReductionMethod, Study,
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -269,7 +270,14 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
-                LawSpec::Contact { tangential, preload, normal_stiffness, tangential_stiffness, friction, .. } => (
+                LawSpec::Contact(ContactSpec {
+                    tangential,
+                    preload,
+                    normal_stiffness,
+                    tangential_stiffness,
+                    friction,
+                    ..
+                }) => (
                     if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
                     format!(
                         "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
@@ -286,7 +294,7 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                 Placement::Vector(_) => "a vector over the DOFs".to_string(),
             };
             let placement = match &j.law {
-                LawSpec::Contact { tangential, normal, .. } => format!(
+                LawSpec::Contact(ContactSpec { tangential, normal, .. }) => format!(
                     "tangential {}; normal {}",
                     tangential.iter().map(describe).collect::<Vec<_>>().join(", "),
                     describe(normal)
