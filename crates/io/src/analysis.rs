@@ -23,8 +23,8 @@ use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
 };
 use crate::study::{
-    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod,
-    Snapshot, Study,
+    self, ContactSpec, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement,
+    ReductionMethod, Snapshot, Study,
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -221,9 +221,10 @@ pub fn run_snapshot(
     let sides = study
         .joints
         .iter()
-        .zip(&point.elements)
-        .filter_map(|(j, e)| {
+        .filter_map(|j| {
             let Placement::Between(a, b) = &j.placement else { return None };
+            // A one-direction joint's record has the joint's name (contacts have one per direction).
+            let e = point.elements.iter().find(|e| e.name == j.name)?;
             let o = study.outputs.iter().position(|o| matches!(&o.placement, Placement::Dof(d) if d == b))?;
             let velocity_b = point.outputs[o].vel.clone();
             let velocity_a = velocity_b.iter().zip(&e.slider_velocity).map(|(v, w)| v + w).collect();
@@ -409,7 +410,14 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
-                LawSpec::Contact { tangential, preload, normal_stiffness, tangential_stiffness, friction, .. } => (
+                LawSpec::Contact(ContactSpec {
+                    tangential,
+                    preload,
+                    normal_stiffness,
+                    tangential_stiffness,
+                    friction,
+                    ..
+                }) => (
                     if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
                     format!(
                         "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
@@ -420,10 +428,18 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     ),
                 ),
             };
-            let placement = match &j.placement {
+            let describe = |p: &Placement| match p {
                 Placement::Dof(d) => format!("DOF {d} and the ground"),
                 Placement::Between(a, b) => format!("DOFs {a} and {b}"),
                 Placement::Vector(_) => "a vector over the DOFs".to_string(),
+            };
+            let placement = match &j.law {
+                LawSpec::Contact(ContactSpec { tangential, normal, .. }) => format!(
+                    "tangential {}; normal {}",
+                    tangential.iter().map(describe).collect::<Vec<_>>().join(", "),
+                    describe(normal)
+                ),
+                _ => describe(&j.placement),
             };
             JointSummary { name: j.name.clone(), placement, law: law.to_string(), parameters }
         })

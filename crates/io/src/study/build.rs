@@ -294,7 +294,14 @@ impl Study {
                 Box::new(RegularizedCoulomb::new(*threshold, *velocity_scale).map_err(element_error)?)
             }
             LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
-            LawSpec::Contact { tangential, normal, preload, normal_stiffness, tangential_stiffness, friction } => {
+            LawSpec::Contact(ContactSpec {
+                tangential,
+                normal,
+                preload,
+                normal_stiffness,
+                tangential_stiffness,
+                friction,
+            }) => {
                 // Directions tangential first, then normal, as the element expects; a pair is
                 // U_a − U_b (no normalisation: the stiffnesses act on that difference).
                 let directions =

@@ -693,14 +693,14 @@ fn contact_law(
             x
         }
     };
-    Ok(LawSpec::Contact {
+    Ok(LawSpec::Contact(ContactSpec {
         tangential,
         normal,
         preload,
         normal_stiffness: need(&r.normal_stiffness, "normal_stiffness", " N/m")?,
         tangential_stiffness: need(&r.tangential_stiffness, "tangential_stiffness", " N/m")?,
         friction,
-    })
+    }))
 }
 
 fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
