@@ -302,3 +302,28 @@ fn an_undamped_sweep_started_on_a_natural_frequency_steps_off_it_and_says_so() {
         assert!(stderr.contains("meets a natural frequency of the undamped linear model"), "{stderr}");
     }
 }
+
+#[test]
+fn fine_steps_over_a_flat_friction_peak_cross_the_band() {
+    // Steps of 0.005 Hz (largest 0.05 Hz) over 150-350 Hz at 1000 N took the 10,000 points the
+    // default allowed before 210 Hz: across the peak the response turns while the frequency
+    // hardly moves. The default now scales with band / max_step_hz.
+    let dir = scratch("fine-steps");
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+        .unwrap()
+        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
+        .replace("end_hz = 350.0", "end_hz = 350.0\nstep_hz = 0.005")
+        .replace("time_data = 10", "time_data = \"none\"");
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-report", "--out"])
+        .arg(&dir)
+        .arg(dir.join("study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let f = &columns(&dir.join("frf.csv"))["frequency_Hz"];
+    assert!(f.len() > 10_000, "{} points", f.len());
+    assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
+}

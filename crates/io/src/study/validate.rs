@@ -893,9 +893,21 @@ fn continuation(
         predictor: Predictor::Secant,
         min_step_hz: sweep.step_hz / 1000.0,
         max_step_hz: sweep.step_hz * 10.0,
-        max_points: 10_000,
+        max_points: 0,
     };
-    let Some(c) = c else { return Ok(out) };
+    // Default: room for 50 bands at the largest step. Arclength steps are in x as well as in
+    // the frequency: across a resonance the response turns through half a circle while the
+    // frequency hardly moves, so a sweep takes several times band / max_step points, the more
+    // the finer the steps a user asks (a flat friction peak at 0.005 Hz steps took 10,000 points
+    // before 210 Hz of a 150-350 Hz band).
+    let default_points = |max_step_hz: f64| {
+        let band = (sweep.end_hz - sweep.start_hz).abs();
+        ((50.0 * band / max_step_hz).ceil() as usize).clamp(10_000, 10_000_000)
+    };
+    let Some(c) = c else {
+        out.max_points = default_points(out.max_step_hz);
+        return Ok(out);
+    };
     let r = c.get_ref();
     if let Some(p) = &r.predictor {
         out.predictor = match p.get_ref().as_str() {
@@ -927,9 +939,10 @@ fn continuation(
             ),
         ));
     }
-    if let Some(m) = &r.max_points {
-        out.max_points = count(src, m, CTX, "max_points", 2)?;
-    }
+    out.max_points = match &r.max_points {
+        Some(m) => count(src, m, CTX, "max_points", 2)?,
+        None => default_points(out.max_step_hz),
+    };
     Ok(out)
 }
 
