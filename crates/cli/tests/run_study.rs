@@ -327,3 +327,37 @@ fn fine_steps_over_a_flat_friction_peak_cross_the_band() {
     assert!(f.len() > 10_000, "{} points", f.len());
     assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
 }
+
+#[test]
+fn a_grid_solves_each_frequency_on_its_own_and_meets_the_sweep_at_the_band_ends() {
+    // [grid] frequencies are solved one by one (a force ramp at each), no sweep between them.
+    // At the band's ends the response is unique at every level, and the sweep lands there
+    // exactly: the grid's rows equal the sweep's (both converged to 1e-8 of the response;
+    // 1e-7 leaves room for the two paths).
+    let dir = scratch("grid");
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+        .unwrap()
+        .replace("time_data = 10", "time_data = \"none\"")
+        + "\n[grid]\nfrequencies_hz = [150.0, 205.0, 350.0]\n";
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-report", "--out"])
+        .arg(&dir)
+        .arg(dir.join("study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let (sweep, grid) = (columns(&dir.join("frf.csv")), columns(&dir.join("grid.csv")));
+    assert_eq!(grid["frequency_Hz"].len(), 3 * 4);
+    for (i, (&level, &f)) in grid["level_N"].iter().zip(&grid["frequency_Hz"]).enumerate() {
+        if f == 205.0 {
+            continue;
+        }
+        let j = (0..sweep["level_N"].len())
+            .find(|&j| sweep["level_N"][j] == level && (sweep["frequency_Hz"][j] - f).abs() < 1e-9)
+            .expect("the sweep's end point");
+        let (a, b) = (grid["mass_disp_frf_m_per_N"][i], sweep["mass_disp_frf_m_per_N"][j]);
+        assert!((a - b).abs() <= 1e-7 * b, "{level} N, {f} Hz: grid {a:e}, sweep {b:e}");
+    }
+}

@@ -89,8 +89,7 @@ pub fn run_level<O: Observer + ?Sized>(
         &options,
         observer,
     )?;
-    let selectors: Vec<OutputSelector> =
-        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
+    let selectors = selectors(outputs);
     let mut points = Vec::with_capacity(branch.points.len());
     for (index, p) in branch.points.iter().enumerate() {
         let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
@@ -196,28 +195,8 @@ pub fn run_snapshot(
 ) -> Result<SnapshotResult, SnapshotError> {
     let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
     let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
-    let omega = TWO_PI * snapshot.frequency_hz;
-    let start = 1e-3 * snapshot.level;
-    // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
-    let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
-    let branch = sweep_level(&mut hbm, omega, start, snapshot.level, &options, &mut Silent)?;
-    let not_reached = |why: String| SnapshotError::NotReached {
-        frequency_hz: snapshot.frequency_hz,
-        level: snapshot.level,
-        start,
-        why,
-    };
-    let p = match (&branch.termination, branch.points.last()) {
-        (TerminationReason::ReachedEnd, Some(p)) => p,
-        (t, last) => {
-            let reached = last.map_or(start, |p| p.lambda);
-            return Err(not_reached(format!("stopped at {reached} N: {}", describe_termination(t))));
-        }
-    };
-    let selectors: Vec<OutputSelector> =
-        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
-    let result = evaluate_point(&mut hbm, &p.x, omega, snapshot.level, &selectors).map_err(SweepError::from)?;
-    let point = record(&result, p.iterations, p.residual_norm / branch.residual_scale, true);
+    let selectors = selectors(outputs);
+    let point = solve_at(study, &mut hbm, &selectors, snapshot.frequency_hz, snapshot.level, true)?;
     let sides = study
         .joints
         .iter()
@@ -232,6 +211,59 @@ pub fn run_snapshot(
         })
         .collect();
     Ok(SnapshotResult { level_n: snapshot.level, point, sides })
+}
+
+/// The response at one frequency and level, reached by a force ramp at that frequency from a
+/// thousandth of the level (see [`run_snapshot`]), post-processed into a record (with its time
+/// signals if `time_data`).
+fn solve_at(
+    study: &Study,
+    hbm: &mut CondensedHbm<'_>,
+    selectors: &[OutputSelector],
+    frequency_hz: f64,
+    level: f64,
+    time_data: bool,
+) -> Result<PointRecord, SnapshotError> {
+    let omega = TWO_PI * frequency_hz;
+    let start = 1e-3 * level;
+    // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
+    let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
+    let branch = sweep_level(hbm, omega, start, level, &options, &mut Silent)?;
+    let p = match (&branch.termination, branch.points.last()) {
+        (TerminationReason::ReachedEnd, Some(p)) => p,
+        (t, last) => {
+            let reached = last.map_or(start, |p| p.lambda);
+            let why = format!("stopped at {reached} N: {}", describe_termination(t));
+            return Err(SnapshotError::NotReached { frequency_hz, level, start, why });
+        }
+    };
+    let result = evaluate_point(hbm, &p.x, omega, level, selectors).map_err(SweepError::from)?;
+    Ok(record(&result, p.iterations, p.residual_norm / branch.residual_scale, time_data))
+}
+
+/// The responses at the study's `[grid]` frequencies at force `level` (N), each solved on its
+/// own (no sweep between them) as [`run_snapshot`] does: the FRF on a grid, as the columns of
+/// `frf.csv`. A frequency that cannot be solved is an error naming it.
+pub fn run_grid(
+    study: &Study,
+    model: &NonlinearModel,
+    excitation: &Excitation,
+    outputs: &[OutputSpec],
+    level: f64,
+) -> Result<LevelResult, SnapshotError> {
+    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
+    let selectors = selectors(outputs);
+    let points = study
+        .grid_hz
+        .iter()
+        .map(|&f| solve_at(study, &mut hbm, &selectors, f, level, false))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(LevelResult { level_n: level, points, peaks: Vec::new() })
+}
+
+fn selectors(outputs: &[OutputSpec]) -> Vec<OutputSelector> {
+    outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect()
 }
 
 /// A point's results as a record; the time signals only when `time_data`.

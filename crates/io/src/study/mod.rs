@@ -41,6 +41,9 @@ pub struct Study {
     pub output_options: OutputOptions,
     /// Periodic responses asked at fixed (frequency, level) pairs, besides the sweeps.
     pub snapshots: Vec<Snapshot>,
+    /// `[grid] frequencies_hz`: frequencies (Hz) solved one by one at every level, besides the
+    /// sweeps (empty: none).
+    pub grid_hz: Vec<f64>,
 }
 
 /// Line and column (both from 1) of a key in the study file.

@@ -58,6 +58,9 @@ fn is_header(line: &str) -> bool {
     line.starts_with('[') && line.trim_start_matches('[').starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
 }
 
+/// Most frequencies of a `[grid]` (each is a solve of its own).
+const MAX_GRID: usize = 100_000;
+
 pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     let src = Source { file, text };
     let raw: RawStudy = toml::from_str(text).map_err(|e| {
@@ -128,6 +131,24 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     }
     unique_names(&src, raw.output.iter().map(|o| &o.get_ref().name), "[[output]]")?;
     let output_options = output_options(&src, raw.output_options.as_ref())?;
+    let grid_hz = match &raw.grid {
+        None => Vec::new(),
+        Some(g) => {
+            const CTX: &str = "[grid]";
+            let f = &g.get_ref().frequencies_hz;
+            let values = finite_list(&src, f, CTX, "frequencies_hz")?;
+            if values.is_empty() || values.len() > MAX_GRID || values.iter().any(|v| *v <= 0.0) {
+                return Err(src.invalid(
+                    &f.span(),
+                    format!(
+                        "{CTX}: frequencies_hz must be 1 to {MAX_GRID} frequencies > 0 Hz, got {} values",
+                        values.len()
+                    ),
+                ));
+            }
+            values
+        }
+    };
     let mut snapshots = Vec::with_capacity(raw.snapshot.len());
     for s in &raw.snapshot {
         let r = s.get_ref();
@@ -153,6 +174,7 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         outputs,
         output_options,
         snapshots,
+        grid_hz,
     })
 }
 
