@@ -361,3 +361,21 @@ fn a_grid_solves_each_frequency_on_its_own_and_meets_the_sweep_at_the_band_ends(
         assert!((a - b).abs() <= 1e-7 * b, "{level} N, {f} Hz: grid {a:e}, sweep {b:e}");
     }
 }
+
+#[test]
+fn no_plots_writes_the_tables_and_no_image() {
+    let out = scratch("no-plots");
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-plots", "--out"])
+        .arg(&out)
+        .arg(repo().join("examples/jenkins-1dof/study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    for table in ["frf.csv", "frf.npz", "peaks.csv", "report.html"] {
+        assert!(names.iter().any(|n| n == table), "{table} missing from {names:?}");
+    }
+    assert!(!names.iter().any(|n| n.ends_with(".png") || n.ends_with(".svg")), "{names:?}");
+}

@@ -24,6 +24,9 @@ pub struct Args {
     /// Do not write the HTML report (report.html).
     #[arg(long)]
     pub no_report: bool,
+    /// Do not draw plots (batch runs: the tables and time data only).
+    #[arg(long)]
+    pub no_plots: bool,
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
@@ -117,8 +120,9 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let written = Instant::now();
 
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
-    let mut files = write_results(&args.out, &levels, study.output_options.plot_format)?;
-    files.extend(write_snapshots(&args.out, &snapshots, study.output_options.plot_format)?);
+    let plots = (!args.no_plots).then_some(study.output_options.plot_format);
+    let mut files = write_results(&args.out, &levels, plots)?;
+    files.extend(write_snapshots(&args.out, &snapshots, plots)?);
     if !grid.is_empty() {
         let path = args.out.join("grid.csv");
         write_frf_csv(&path, &grid)?;
