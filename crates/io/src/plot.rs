@@ -114,11 +114,22 @@ impl Chart {
             let y = log_axis(y0, y1);
             (y0, y1) = (y.start, y.end);
             let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;
+            // Over more than a decade, label the decades only (1e-7, 1e-6, ...): the ticks in
+            // between (2e-7, 3e-7, ...) crowd the axis; over less, every tick.
+            let per_decade = (y1 / y0).log10() > 1.0;
+            let label = move |y: &f64| {
+                let exponent = y.log10();
+                if per_decade && (exponent - exponent.round()).abs() > 1e-9 {
+                    String::new()
+                } else {
+                    format!("{y:.0e}")
+                }
+            };
             chart
                 .configure_mesh()
                 .x_desc(&self.x_label)
                 .y_desc(&self.y_label)
-                .y_label_formatter(&|y| format!("{y:.0e}"))
+                .y_label_formatter(&label)
                 .label_style((FONT, 15))
                 .draw()
                 .map_err(e)?;
