@@ -1,20 +1,6 @@
 //! Commands that chain: each consumes the previous one's files as written.
 mod common;
-use common::{repo, scratch, stickslip};
-
-/// CSV columns by name.
-fn columns(path: &std::path::Path) -> std::collections::HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    for l in lines {
-        for (c, v) in cols.iter_mut().zip(l.split(',')) {
-            c.push(v.parse().unwrap());
-        }
-    }
-    names.into_iter().zip(cols).collect()
-}
+use common::{columns, repo, scratch, stickslip};
 
 #[test]
 fn reduce_then_run_on_the_reduced_matrices_gives_the_study_with_its_own_reduction() {

@@ -2,7 +2,7 @@
 use std::path::PathBuf;
 
 mod common;
-use common::{repo, scratch, stickslip};
+use common::{columns, repo, run_table6, scratch, stickslip};
 
 /// Run a shipped example into a scratch folder; its FRF table as (header, rows), and the folder.
 fn run_example(name: &str) -> (Vec<String>, Vec<Vec<f64>>, PathBuf) {
@@ -77,20 +77,6 @@ fn the_blade_example_runs_from_the_mesh_and_softens_as_the_contact_slips() {
     // 20 N: the contact slips most of the period, the resonance falls towards the free tip's.
     let (f_slip, _) = peak(20.0);
     assert!(f_slip < 330.0, "slipping peak at {f_slip} Hz");
-}
-
-/// CSV columns by name.
-fn columns(path: &std::path::Path) -> std::collections::HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    for l in lines {
-        for (c, v) in cols.iter_mut().zip(l.split(',')) {
-            c.push(v.parse().unwrap());
-        }
-    }
-    names.into_iter().zip(cols).collect()
 }
 
 #[test]
@@ -193,7 +179,8 @@ fn the_table_6_peak_at_1000_n_is_located_at_the_maximum_of_a_dense_grid() {
     // branch's maximum. Reference: the maximum of a grid of fixed-frequency solves every 0.001 Hz
     // (206.039 Hz, 3.57434e-4 m), checked here again on a grid of snapshots (force ramps at
     // fixed frequencies) around it: none is higher than the located peak.
-    let (_, _, out) = run_example("jenkins-1dof");
+    let (out, run) = run_table6("peaks", &[], "");
+    assert!(run.status.success());
     let peaks = std::fs::read_to_string(out.join("peaks.csv")).unwrap();
     let row: Vec<&str> = peaks.lines().find(|l| l.starts_with("1e3,mass,")).expect("1000 N row").split(',').collect();
     let (f, frf, located): (f64, f64, &str) = (row[2].parse().unwrap(), row[3].parse().unwrap(), row[5]);
@@ -202,24 +189,12 @@ fn the_table_6_peak_at_1000_n_is_located_at_the_maximum_of_a_dense_grid() {
     assert!((f - 206.039).abs() < 1e-5 * 206.039, "{f} Hz");
     assert!((amplitude - 3.57434e-4).abs() < 1e-6 * 3.57434e-4, "{amplitude} m");
 
-    let dir = scratch("peak-grid");
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
-        .unwrap()
-        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
-        .replace("time_data = 10", "time_data = \"none\"");
     let grid: Vec<f64> = (0..41).map(|i| f - 0.02 + 0.001 * i as f64).collect();
-    for g in &grid {
-        study.push_str(&format!("\n[[snapshot]]\nfrequency_hz = {g}\nlevel = 1000.0\n"));
-    }
-    std::fs::write(dir.join("study.toml"), study).unwrap();
-    let status = stickslip()
-        .args(["run", "--quiet", "--no-report", "--out"])
-        .arg(&dir)
-        .arg(dir.join("study.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let snapshots: String =
+        grid.iter().map(|g| format!("\n[[snapshot]]\nfrequency_hz = {g}\nlevel = 1000.0\n")).collect();
+    let (dir, out) =
+        run_table6("peak-grid", &[("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")], &snapshots);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let mut best: f64 = 0.0;
     for i in 0..grid.len() {
         let c = columns(&dir.join(format!("snapshot{i}.csv")));
@@ -245,22 +220,16 @@ fn table_6_crosses_20_to_2000_hz_at_3000_n_through_its_superharmonic_peak() {
     // The third harmonic resonates near 72 Hz (3 × 72 Hz on the slipping resonance): a sharp
     // peak where the secant predictor kept pointing off the curve and the branch stopped at
     // 71.6 Hz. With default settings it now crosses the band.
-    let dir = scratch("wide-band");
-    std::fs::create_dir_all(&dir).unwrap();
-    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
-        .unwrap()
-        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [3000.0]")
-        .replace("start_hz = 150.0", "start_hz = 20.0")
-        .replace("end_hz = 350.0", "end_hz = 2000.0")
-        .replace("time_data = 10", "time_data = \"none\"");
-    std::fs::write(dir.join("study.toml"), study).unwrap();
-    let status = stickslip()
-        .args(["run", "--quiet", "--no-report", "--out"])
-        .arg(&dir)
-        .arg(dir.join("study.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (dir, out) = run_table6(
+        "wide-band",
+        &[
+            ("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [3000.0]"),
+            ("start_hz = 150.0", "start_hz = 20.0"),
+            ("end_hz = 350.0", "end_hz = 2000.0"),
+        ],
+        "",
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let c = columns(&dir.join("frf.csv"));
     let (f, h1, h3) = (&c["frequency_Hz"], &c["mass_h1_amp_m"], &c["mass_h3_amp_m"]);
     assert!((f[f.len() - 1] - 2000.0).abs() < 1e-9);
@@ -276,21 +245,16 @@ fn an_undamped_sweep_started_on_a_natural_frequency_steps_off_it_and_says_so() {
     // harmonic 3 on it), the branch starts 1e-6 of Ω off and crosses the band.
     let wn_hz = (2.24e7f64 / 10.0).sqrt() / (2.0 * std::f64::consts::PI);
     for start in [wn_hz, wn_hz / 3.0] {
-        let dir = scratch("undamped");
-        std::fs::create_dir_all(&dir).unwrap();
-        let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
-            .unwrap()
-            .replace("alpha = 35.0", "alpha = 0.0")
-            .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
-            .replace("start_hz = 150.0", &format!("start_hz = {start:?}"))
-            .replace("time_data = 10", "time_data = \"none\"");
-        std::fs::write(dir.join("study.toml"), study).unwrap();
-        let out = stickslip()
-            .args(["run", "--quiet", "--no-report", "--out"])
-            .arg(&dir)
-            .arg(dir.join("study.toml"))
-            .output()
-            .unwrap();
+        let start_hz = format!("start_hz = {start:?}");
+        let (dir, out) = run_table6(
+            "undamped",
+            &[
+                ("alpha = 35.0", "alpha = 0.0"),
+                ("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]"),
+                ("start_hz = 150.0", &start_hz),
+            ],
+            "",
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{stderr}");
         let c = columns(&dir.join("frf.csv"));
@@ -308,21 +272,15 @@ fn fine_steps_over_a_flat_friction_peak_cross_the_band() {
     // Steps of 0.005 Hz (largest 0.05 Hz) over 150-350 Hz at 1000 N took the 10,000 points the
     // default allowed before 210 Hz: across the peak the response turns while the frequency
     // hardly moves. The default now scales with band / max_step_hz.
-    let dir = scratch("fine-steps");
-    std::fs::create_dir_all(&dir).unwrap();
-    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
-        .unwrap()
-        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
-        .replace("end_hz = 350.0", "end_hz = 350.0\nstep_hz = 0.005")
-        .replace("time_data = 10", "time_data = \"none\"");
-    std::fs::write(dir.join("study.toml"), study).unwrap();
-    let status = stickslip()
-        .args(["run", "--quiet", "--no-report", "--out"])
-        .arg(&dir)
-        .arg(dir.join("study.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (dir, out) = run_table6(
+        "fine-steps",
+        &[
+            ("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]"),
+            ("end_hz = 350.0", "end_hz = 350.0\nstep_hz = 0.005"),
+        ],
+        "",
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let f = &columns(&dir.join("frf.csv"))["frequency_Hz"];
     assert!(f.len() > 10_000, "{} points", f.len());
     assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
@@ -334,20 +292,8 @@ fn a_grid_solves_each_frequency_on_its_own_and_meets_the_sweep_at_the_band_ends(
     // At the band's ends the response is unique at every level, and the sweep lands there
     // exactly: the grid's rows equal the sweep's (both converged to 1e-8 of the response;
     // 1e-7 leaves room for the two paths).
-    let dir = scratch("grid");
-    std::fs::create_dir_all(&dir).unwrap();
-    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
-        .unwrap()
-        .replace("time_data = 10", "time_data = \"none\"")
-        + "\n[grid]\nfrequencies_hz = [150.0, 205.0, 350.0]\n";
-    std::fs::write(dir.join("study.toml"), study).unwrap();
-    let status = stickslip()
-        .args(["run", "--quiet", "--no-report", "--out"])
-        .arg(&dir)
-        .arg(dir.join("study.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (dir, out) = run_table6("grid", &[], "\n[grid]\nfrequencies_hz = [150.0, 205.0, 350.0]\n");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let (sweep, grid) = (columns(&dir.join("frf.csv")), columns(&dir.join("grid.csv")));
     assert_eq!(grid["frequency_Hz"].len(), 3 * 4);
     for (i, (&level, &f)) in grid["level_N"].iter().zip(&grid["frequency_Hz"]).enumerate() {
