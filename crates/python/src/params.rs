@@ -4,7 +4,7 @@
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use stickslip_io::params::{files, ParamError as IoParamError, ParamStudy, SampleOutcome, Vary};
+use stickslip_io::params::{files, ParamError as IoParamError, ParamStudy, SampleOutcome, SampleRunner, Vary};
 
 use crate::convert::{guarded, table_from_dict, ParamError, StudyError};
 use crate::study::PyStudy;
@@ -103,7 +103,12 @@ impl PyParamDesign {
         }
         let inner = &self.inner;
         let outcomes: Vec<SampleOutcome> = py.detach(|| {
-            guarded(|| Ok(indices.iter().map(|&i| inner.run_sample(i, output.as_deref(), curves)).collect()))
+            guarded(|| {
+                // The samples of a batch share the linear model (and its reduction) while
+                // their varied keys leave it unchanged (see `SampleRunner`).
+                let mut runner = SampleRunner::new(inner);
+                Ok(indices.iter().map(|&i| runner.run(i, output.as_deref(), curves)).collect())
+            })
         })?;
         outcomes.iter().map(|o| outcome_dict(py, o)).collect()
     }
