@@ -72,7 +72,7 @@ fn compare(p: &ParamStudy) -> usize {
         let fresh = p.run_sample(i, None, true);
         assert_eq!(r.error, None, "sample {i}");
         assert_eq!(fresh.error, None, "sample {i}");
-        assert_eq!(r.rows.len(), 2);
+        assert_eq!(r.rows.len(), 2, "sample {i}: {:?}", r.error);
         // The same model is built from the same numbers in the same order: results agree to
         // round-off, asked at 1e-12 relative (every value, every point of every curve).
         let close = |a: f64, b: f64, what: &str| {
@@ -118,4 +118,21 @@ fn keys_of_the_linear_model_or_of_the_released_joints_rebuild_it() {
     // The threshold varying fastest in a grid: a build per stiffness value only.
     let p = study(&["joint.j.stiffness=0.5e6,1.0e6", "joint.j.threshold=30,50"], None);
     assert_eq!(compare(&p), 2);
+}
+
+/// The coarse Harmony model (refinement 0.5, enriched reduction): two thresholds on one
+/// reduction equal two builds from scratch. Minutes on a shared 2-core machine: run with
+/// `cargo test -p stickslip-io --test params_reuse -- --ignored`.
+#[test]
+#[ignore]
+fn the_coarse_harmony_reuses_its_reduction_with_the_same_results() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/harmony/study.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("refinement = 1.0"), "the example's refinement line changed");
+    let mut table: toml::Table = toml::from_str(&text.replace("refinement = 1.0", "refinement = 0.5")).unwrap();
+    // Two of the paper's levels, one below and one above the joints' first slip.
+    table["excitation"]["levels"] = toml::Value::Array(vec![70.0.into(), 1875.0.into()]);
+    let varies = [Vary::parse("joint.blade1.threshold=250,330").unwrap()];
+    let p = ParamStudy::new(table, &path, &varies, None, 0).unwrap();
+    assert_eq!(compare(&p), 1);
 }
