@@ -238,6 +238,17 @@ impl<'a> SampleRunner<'a> {
         SampleRunner { study, base: None, builds: 0 }
     }
 
+    /// A runner that starts from a base kept from an earlier runner of the same study (a
+    /// worker's next batch); it is used only if the samples share it.
+    pub fn with_base(study: &'a ParamStudy, base: Option<LinearBase>) -> Self {
+        SampleRunner { study, base, builds: 0 }
+    }
+
+    /// The base built or kept last, for a later runner of the same study.
+    pub fn into_base(self) -> Option<LinearBase> {
+        self.base
+    }
+
     /// Run sample `index`; a failure is recorded in the outcome (as `run_sample`).
     pub fn run(&mut self, index: usize, output: Option<&str>, curves: bool) -> SampleOutcome {
         let values = self.study.samples[index].clone();
