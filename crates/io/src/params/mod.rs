@@ -5,7 +5,9 @@
 //! ([`KeyPath`]) and goes through the study's own validation ([`Study::from_table`]), so a
 //! sample is exactly the study file one would write by hand. Each sample is summarised per
 //! force level ([`SummaryRow`]: the peak of the first harmonic of an output, its frequency and
-//! the energy the joints dissipate there); the full curves are kept on request.
+//! the energy the joints dissipate there); the full curves are kept on request. A
+//! [`SampleRunner`] keeps the linear model (and its reduction) of one sample for the next ones
+//! that share it.
 //!
 //! The command line shards the samples over batch jobs and merges their tables
 //! ([`files`]); the Python package schedules the same samples on processes or Dask.
