@@ -26,6 +26,10 @@ fn the_1dof_example_writes_an_frf_table_covering_the_band_at_every_level() {
     let (header, rows, out) = run_example("jenkins-1dof");
     assert_eq!(&header[..2], &["level_N", "frequency_Hz"]);
     let accel = header.iter().position(|h| h == "mass_accel_frf_m_s2_per_N").expect("acceleration FRF column");
+    // residual_rel is the measure Newton's tolerance (default 1e-8) applies to.
+    let residual = header.iter().position(|h| h == "residual_rel").unwrap();
+    assert!(rows.iter().all(|r| r[residual] <= 1e-8), "a residual above the tolerance");
+    assert!(rows.iter().any(|r| r[residual] > 1e-12), "residuals all round-off: not the tolerance's measure?");
     for level in [100.0, 1000.0, 3000.0, 10000.0] {
         let f: Vec<f64> = rows.iter().filter(|r| r[0] == level).map(|r| r[1]).collect();
         assert!(f.len() > 20, "level {level}: {} points", f.len());
@@ -297,4 +301,81 @@ fn an_undamped_sweep_started_on_a_natural_frequency_steps_off_it_and_says_so() {
         assert!((off - 1e-6).abs() < 1e-12, "started {off:e} off");
         assert!(stderr.contains("meets a natural frequency of the undamped linear model"), "{stderr}");
     }
+}
+
+#[test]
+fn fine_steps_over_a_flat_friction_peak_cross_the_band() {
+    // Steps of 0.005 Hz (largest 0.05 Hz) over 150-350 Hz at 1000 N took the 10,000 points the
+    // default allowed before 210 Hz: across the peak the response turns while the frequency
+    // hardly moves. The default now scales with band / max_step_hz.
+    let dir = scratch("fine-steps");
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+        .unwrap()
+        .replace("levels = [100.0, 1000.0, 3000.0, 10000.0]", "levels = [1000.0]")
+        .replace("end_hz = 350.0", "end_hz = 350.0\nstep_hz = 0.005")
+        .replace("time_data = 10", "time_data = \"none\"");
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-report", "--out"])
+        .arg(&dir)
+        .arg(dir.join("study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let f = &columns(&dir.join("frf.csv"))["frequency_Hz"];
+    assert!(f.len() > 10_000, "{} points", f.len());
+    assert!((f[f.len() - 1] - 350.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_grid_solves_each_frequency_on_its_own_and_meets_the_sweep_at_the_band_ends() {
+    // [grid] frequencies are solved one by one (a force ramp at each), no sweep between them.
+    // At the band's ends the response is unique at every level, and the sweep lands there
+    // exactly: the grid's rows equal the sweep's (both converged to 1e-8 of the response;
+    // 1e-7 leaves room for the two paths).
+    let dir = scratch("grid");
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = std::fs::read_to_string(repo().join("examples/jenkins-1dof/study.toml"))
+        .unwrap()
+        .replace("time_data = 10", "time_data = \"none\"")
+        + "\n[grid]\nfrequencies_hz = [150.0, 205.0, 350.0]\n";
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-report", "--out"])
+        .arg(&dir)
+        .arg(dir.join("study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let (sweep, grid) = (columns(&dir.join("frf.csv")), columns(&dir.join("grid.csv")));
+    assert_eq!(grid["frequency_Hz"].len(), 3 * 4);
+    for (i, (&level, &f)) in grid["level_N"].iter().zip(&grid["frequency_Hz"]).enumerate() {
+        if f == 205.0 {
+            continue;
+        }
+        let j = (0..sweep["level_N"].len())
+            .find(|&j| sweep["level_N"][j] == level && (sweep["frequency_Hz"][j] - f).abs() < 1e-9)
+            .expect("the sweep's end point");
+        let (a, b) = (grid["mass_disp_frf_m_per_N"][i], sweep["mass_disp_frf_m_per_N"][j]);
+        assert!((a - b).abs() <= 1e-7 * b, "{level} N, {f} Hz: grid {a:e}, sweep {b:e}");
+    }
+}
+
+#[test]
+fn no_plots_writes_the_tables_and_no_image() {
+    let out = scratch("no-plots");
+    let status = stickslip()
+        .args(["run", "--quiet", "--no-plots", "--out"])
+        .arg(&out)
+        .arg(repo().join("examples/jenkins-1dof/study.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    for table in ["frf.csv", "frf.npz", "peaks.csv", "report.html"] {
+        assert!(names.iter().any(|n| n == table), "{table} missing from {names:?}");
+    }
+    assert!(!names.iter().any(|n| n.ends_with(".png") || n.ends_with(".svg")), "{names:?}");
 }

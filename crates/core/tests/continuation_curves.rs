@@ -413,3 +413,56 @@ fn a_corner_of_a_non_smooth_branch_is_passed_after_corner_after_halvings() {
         }
     }
 }
+
+/// x = sin(4λ), whose law fails (as an element's AFT on a wild trial motion) at any iterate
+/// farther than 0.02 from the branch.
+struct Fragile {
+    failures: usize,
+}
+
+impl Problem for Fragile {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        residual[0] = x[0] - (4.0 * lambda).sin();
+        if residual[0].abs() > 0.02 {
+            self.failures += 1;
+            return Err(ProblemError::at_trial_iterate(format!("no periodic regime at x = {}", x[0])));
+        }
+        if let Some((mut jx, dl)) = jacobian {
+            jx[(0, 0)] = 1.0;
+            dl[0] = -4.0 * (4.0 * lambda).cos();
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn a_failure_at_a_trial_iterate_rejects_the_step_instead_of_ending_the_branch() {
+    // Steps of 0.1 (scaled) predict iterates up to ~0.1 off the curve: those fail, are halved,
+    // and the branch goes on to the end.
+    let options = Options { initial_step: 0.1, max_step: 0.2, ..Options::default() };
+    let mut problem = Fragile { failures: 0 };
+    let branch = run(&mut problem, 0.0, 0.0, 2.0, &options);
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    assert!(problem.failures > 0, "no trial iterate failed: the test does not test");
+    assert!(branch.points.iter().map(|p| p.rejected).sum::<usize>() > 0);
+    assert!(branch.points.iter().all(|p| (p.x[0] - (4.0 * p.lambda).sin()).abs() <= 1e-9));
+    // At the first point the same error ends the branch, with its message.
+    let mut problem = Fragile { failures: 0 };
+    let branch = run(&mut problem, 1.0, 0.0, 2.0, &options);
+    match &branch.termination {
+        TerminationReason::ProblemError { lambda, last_lambda: None, error } => {
+            assert_eq!(*lambda, 0.0);
+            assert!(error.message.contains("no periodic regime"), "{}", error.message);
+        }
+        other => panic!("expected ProblemError, got {other:?}"),
+    }
+}

@@ -23,8 +23,8 @@ use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
 };
 use crate::study::{
-    self, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement, ReductionMethod,
-    Snapshot, Study,
+    self, ContactSpec, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement,
+    ReductionMethod, Snapshot, Study,
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -89,13 +89,12 @@ pub fn run_level<O: Observer + ?Sized>(
         &options,
         observer,
     )?;
-    let selectors: Vec<OutputSelector> =
-        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
+    let selectors = selectors(outputs);
     let mut points = Vec::with_capacity(branch.points.len());
     for (index, p) in branch.points.iter().enumerate() {
         let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
-        let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let residual = p.residual_norm / x_norm.max(f64::MIN_POSITIVE);
+        // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
+        let residual = p.residual_norm / branch.residual_scale;
         points.push(record(&result, p.iterations, residual, study.output_options.time_data.keeps(index)));
     }
     let peaks = locate_peaks(&mut hbm, &branch, level, &selectors, &points);
@@ -196,35 +195,15 @@ pub fn run_snapshot(
 ) -> Result<SnapshotResult, SnapshotError> {
     let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
     let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
-    let omega = TWO_PI * snapshot.frequency_hz;
-    let start = 1e-3 * snapshot.level;
-    // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
-    let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
-    let branch = sweep_level(&mut hbm, omega, start, snapshot.level, &options, &mut Silent)?;
-    let not_reached = |why: String| SnapshotError::NotReached {
-        frequency_hz: snapshot.frequency_hz,
-        level: snapshot.level,
-        start,
-        why,
-    };
-    let p = match (&branch.termination, branch.points.last()) {
-        (TerminationReason::ReachedEnd, Some(p)) => p,
-        (t, last) => {
-            let reached = last.map_or(start, |p| p.lambda);
-            return Err(not_reached(format!("stopped at {reached} N: {}", describe_termination(t))));
-        }
-    };
-    let selectors: Vec<OutputSelector> =
-        outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect();
-    let result = evaluate_point(&mut hbm, &p.x, omega, snapshot.level, &selectors).map_err(SweepError::from)?;
-    let x_norm = p.x.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let point = record(&result, p.iterations, p.residual_norm / x_norm.max(f64::MIN_POSITIVE), true);
+    let selectors = selectors(outputs);
+    let point = solve_at(study, &mut hbm, &selectors, snapshot.frequency_hz, snapshot.level, true)?;
     let sides = study
         .joints
         .iter()
-        .zip(&point.elements)
-        .filter_map(|(j, e)| {
+        .filter_map(|j| {
             let Placement::Between(a, b) = &j.placement else { return None };
+            // A one-direction joint's record has the joint's name (contacts have one per direction).
+            let e = point.elements.iter().find(|e| e.name == j.name)?;
             let o = study.outputs.iter().position(|o| matches!(&o.placement, Placement::Dof(d) if d == b))?;
             let velocity_b = point.outputs[o].vel.clone();
             let velocity_a = velocity_b.iter().zip(&e.slider_velocity).map(|(v, w)| v + w).collect();
@@ -232,6 +211,59 @@ pub fn run_snapshot(
         })
         .collect();
     Ok(SnapshotResult { level_n: snapshot.level, point, sides })
+}
+
+/// The response at one frequency and level, reached by a force ramp at that frequency from a
+/// thousandth of the level (see [`run_snapshot`]), post-processed into a record (with its time
+/// signals if `time_data`).
+fn solve_at(
+    study: &Study,
+    hbm: &mut CondensedHbm<'_>,
+    selectors: &[OutputSelector],
+    frequency_hz: f64,
+    level: f64,
+    time_data: bool,
+) -> Result<PointRecord, SnapshotError> {
+    let omega = TWO_PI * frequency_hz;
+    let start = 1e-3 * level;
+    // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
+    let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
+    let branch = sweep_level(hbm, omega, start, level, &options, &mut Silent)?;
+    let p = match (&branch.termination, branch.points.last()) {
+        (TerminationReason::ReachedEnd, Some(p)) => p,
+        (t, last) => {
+            let reached = last.map_or(start, |p| p.lambda);
+            let why = format!("stopped at {reached} N: {}", describe_termination(t));
+            return Err(SnapshotError::NotReached { frequency_hz, level, start, why });
+        }
+    };
+    let result = evaluate_point(hbm, &p.x, omega, level, selectors).map_err(SweepError::from)?;
+    Ok(record(&result, p.iterations, p.residual_norm / branch.residual_scale, time_data))
+}
+
+/// The responses at the study's `[grid]` frequencies at force `level` (N), each solved on its
+/// own (no sweep between them) as [`run_snapshot`] does: the FRF on a grid, as the columns of
+/// `frf.csv`. A frequency that cannot be solved is an error naming it.
+pub fn run_grid(
+    study: &Study,
+    model: &NonlinearModel,
+    excitation: &Excitation,
+    outputs: &[OutputSpec],
+    level: f64,
+) -> Result<LevelResult, SnapshotError> {
+    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
+    let selectors = selectors(outputs);
+    let points = study
+        .grid_hz
+        .iter()
+        .map(|&f| solve_at(study, &mut hbm, &selectors, f, level, false))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(LevelResult { level_n: level, points, peaks: Vec::new() })
+}
+
+fn selectors(outputs: &[OutputSpec]) -> Vec<OutputSelector> {
+    outputs.iter().map(|o| OutputSelector { name: o.name.clone(), vector: o.vector.clone() }).collect()
 }
 
 /// A point's results as a record; the time signals only when `time_data`.
@@ -410,7 +442,14 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
-                LawSpec::Contact { tangential, preload, normal_stiffness, tangential_stiffness, friction, .. } => (
+                LawSpec::Contact(ContactSpec {
+                    tangential,
+                    preload,
+                    normal_stiffness,
+                    tangential_stiffness,
+                    friction,
+                    ..
+                }) => (
                     if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
                     format!(
                         "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
@@ -421,10 +460,18 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     ),
                 ),
             };
-            let placement = match &j.placement {
+            let describe = |p: &Placement| match p {
                 Placement::Dof(d) => format!("DOF {d} and the ground"),
                 Placement::Between(a, b) => format!("DOFs {a} and {b}"),
                 Placement::Vector(_) => "a vector over the DOFs".to_string(),
+            };
+            let placement = match &j.law {
+                LawSpec::Contact(ContactSpec { tangential, normal, .. }) => format!(
+                    "tangential {}; normal {}",
+                    tangential.iter().map(describe).collect::<Vec<_>>().join(", "),
+                    describe(normal)
+                ),
+                _ => describe(&j.placement),
             };
             JointSummary { name: j.name.clone(), placement, law: law.to_string(), parameters }
         })

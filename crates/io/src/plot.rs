@@ -114,11 +114,22 @@ impl Chart {
             let y = log_axis(y0, y1);
             (y0, y1) = (y.start, y.end);
             let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;
+            // Over more than a decade, label the decades only (1e-7, 1e-6, ...): the ticks in
+            // between (2e-7, 3e-7, ...) crowd the axis; over less, every tick.
+            let per_decade = (y1 / y0).log10() > 1.0;
+            let label = move |y: &f64| {
+                let exponent = y.log10();
+                if per_decade && (exponent - exponent.round()).abs() > 1e-9 {
+                    String::new()
+                } else {
+                    format!("{y:.0e}")
+                }
+            };
             chart
                 .configure_mesh()
                 .x_desc(&self.x_label)
                 .y_desc(&self.y_label)
-                .y_label_formatter(&|y| format!("{y:.0e}"))
+                .y_label_formatter(&label)
                 .label_style((FONT, 15))
                 .draw()
                 .map_err(e)?;
@@ -232,7 +243,7 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
         curves.push(Curve { label: format!("{} N", l.level_n), points });
     }
     Chart {
-        title: format!("FRF of {output}"),
+        title: format!("FRF of {output} (displacement |X₁|/F, one curve per level)"),
         x_label: "Frequency (Hz)".into(),
         y_label: "Displacement / force (m/N)".into(),
         log_y: true,
@@ -277,14 +288,14 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
 }
 
 /// Hysteresis loop of `element` at one point: force (N) against displacement (m), closed.
-pub fn plot_hysteresis(path: &Path, point: &PointRecord, element: &str) -> Result<(), OutputError> {
+pub fn plot_hysteresis(path: &Path, level_n: f64, point: &PointRecord, element: &str) -> Result<(), OutputError> {
     let e = &point.elements[element_index(point, element)?];
     let mut points: Vec<(f64, f64)> = e.loop_u.iter().copied().zip(e.loop_force.iter().copied()).collect();
     if let Some(&p) = points.first() {
         points.push(p);
     }
     Chart {
-        title: format!("Hysteresis of {element} at {:.4} Hz", point.frequency_hz),
+        title: format!("Hysteresis of {element} at {:.4} Hz, {level_n} N", point.frequency_hz),
         x_label: "Displacement (m)".into(),
         y_label: "Force (N)".into(),
         log_y: false,
@@ -294,13 +305,13 @@ pub fn plot_hysteresis(path: &Path, point: &PointRecord, element: &str) -> Resul
 }
 
 /// Slider velocity v_P (m/s, Eq. 33) of `element` over one period against time (ms).
-pub fn plot_slider_velocity(path: &Path, point: &PointRecord, element: &str) -> Result<(), OutputError> {
+pub fn plot_slider_velocity(path: &Path, level_n: f64, point: &PointRecord, element: &str) -> Result<(), OutputError> {
     let e = &point.elements[element_index(point, element)?];
     let n_t = e.slider_velocity.len();
     let period_ms = 1e3 / point.frequency_hz;
     let points = e.slider_velocity.iter().enumerate().map(|(j, &v)| (period_ms * j as f64 / n_t as f64, v)).collect();
     Chart {
-        title: format!("Slider velocity of {element} at {:.4} Hz", point.frequency_hz),
+        title: format!("Slider velocity of {element} at {:.4} Hz, {level_n} N", point.frequency_hz),
         x_label: "Time (ms)".into(),
         y_label: "Velocity (m/s)".into(),
         log_y: false,
@@ -358,11 +369,11 @@ pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat
         let Some(point) = resonance else { continue };
         for e in point.elements.iter().filter(|e| !e.loop_u.is_empty()) {
             let path = dir.join(format!("loop_level{i}_{}.{ext}", e.name));
-            plot_hysteresis(&path, point, &e.name)?;
+            plot_hysteresis(&path, level.level_n, point, &e.name)?;
             files.push(path);
             if !e.slider_velocity.is_empty() {
                 let path = dir.join(format!("slider_level{i}_{}.{ext}", e.name));
-                plot_slider_velocity(&path, point, &e.name)?;
+                plot_slider_velocity(&path, level.level_n, point, &e.name)?;
                 files.push(path);
             }
         }

@@ -188,7 +188,7 @@ fn frf_npz_reads_back_exactly() {
 #[test]
 fn write_results_writes_table_arrays_time_data_and_plots() {
     let dir = scratch_dir("all").join("run");
-    let files = write_results(&dir, &levels(64), PlotFormat::Svg).unwrap();
+    let files = write_results(&dir, &levels(64), Some(PlotFormat::Svg)).unwrap();
     let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
     assert_eq!(names[..5], ["frf.csv", "frf.npz", "peaks.csv", "frf_mass.svg", "frf_slider-P.svg"]);
     // Harmonics of 2 outputs at 2 levels; loop and slider velocity where time data exist.

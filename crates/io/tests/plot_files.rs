@@ -124,11 +124,18 @@ fn harmonics_hysteresis_and_slider_velocity_plots_are_written() {
     assert_png(&dir.join("harmonics.png"));
     plot_harmonics(&dir.join("harmonics.svg"), &levels[2], "mass").unwrap();
     assert!(svg(&dir.join("harmonics.svg")).contains("harmonic 7"));
+    // The harmonics span decades: the log axis labels its decades only (1e-7, not 2e-7).
+    let text = svg(&dir.join("harmonics.svg"));
+    let labels: Vec<&str> = text.lines().map(str::trim).filter(|l| l.len() < 8 && l.contains("e-")).collect();
+    assert!(labels.iter().any(|l| l.starts_with("1e-")), "no decade label in {labels:?}");
+    assert!(labels.iter().all(|l| l.starts_with("1e-")), "a label between decades in {labels:?}");
     let point = &levels[2].points[88];
-    plot_hysteresis(&dir.join("loop.png"), point, "joint").unwrap();
+    plot_hysteresis(&dir.join("loop.png"), 1000.0, point, "joint").unwrap();
     assert_png(&dir.join("loop.png"));
-    plot_slider_velocity(&dir.join("slider.svg"), point, "joint").unwrap();
+    plot_slider_velocity(&dir.join("slider.svg"), 1000.0, point, "joint").unwrap();
     assert!(svg(&dir.join("slider.svg")).contains("Time (ms)"));
+    // The level is in the title of every detail plot.
+    assert!(svg(&dir.join("slider.svg")).contains("1000 N"));
     if std::env::var_os("STICKSLIP_KEEP_PLOTS").is_none() {
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -6,8 +6,8 @@ use anyhow::Context;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
-use stickslip_io::analysis::{describe_termination, run_level, run_snapshot, LevelRun};
-use stickslip_io::output::{write_results, write_snapshots};
+use stickslip_io::analysis::{describe_termination, run_grid, run_level, run_snapshot, LevelRun};
+use stickslip_io::output::{write_frf_csv, write_results, write_snapshots};
 use stickslip_io::report::write_report;
 use stickslip_io::study::Study;
 
@@ -24,6 +24,9 @@ pub struct Args {
     /// Do not write the HTML report (report.html).
     #[arg(long)]
     pub no_report: bool,
+    /// Do not draw plots (batch runs: the tables and time data only).
+    #[arg(long)]
+    pub no_plots: bool,
 }
 
 pub fn main(args: Args) -> anyhow::Result<()> {
@@ -100,14 +103,31 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
         .partition(Result::is_ok);
     let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
-    if !snapshots.is_empty() {
-        timings.push(("snapshots".into(), snapshots_started.elapsed().as_secs_f64()));
+    // The [grid] frequencies, at every level.
+    let (grid, failed_grid): (Vec<_>, Vec<_>) = if study.grid_hz.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        excitation
+            .levels_n
+            .par_iter()
+            .map(|&level| run_grid(&study, &model, &excitation, &outputs, level))
+            .partition(Result::is_ok)
+    };
+    let grid: Vec<_> = grid.into_iter().filter_map(Result::ok).collect();
+    if !snapshots.is_empty() || !study.grid_hz.is_empty() {
+        timings.push(("snapshots and grid".into(), snapshots_started.elapsed().as_secs_f64()));
     }
     let written = Instant::now();
 
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
-    let mut files = write_results(&args.out, &levels, study.output_options.plot_format)?;
-    files.extend(write_snapshots(&args.out, &snapshots, study.output_options.plot_format)?);
+    let plots = (!args.no_plots).then_some(study.output_options.plot_format);
+    let mut files = write_results(&args.out, &levels, plots)?;
+    files.extend(write_snapshots(&args.out, &snapshots, plots)?);
+    if !grid.is_empty() {
+        let path = args.out.join("grid.csv");
+        write_frf_csv(&path, &grid)?;
+        files.push(path);
+    }
     timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
@@ -139,14 +159,19 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .filter(|r| !r.is_complete())
         .map(|r| format!("level {} N {}", r.result.level_n, describe_termination(&r.termination)))
         .collect();
-    let failed: Vec<String> = failed_snapshots.into_iter().filter_map(Result::err).map(|e| e.to_string()).collect();
+    let failed: Vec<String> = failed_snapshots
+        .into_iter()
+        .filter_map(Result::err)
+        .chain(failed_grid.into_iter().filter_map(Result::err))
+        .map(|e| e.to_string())
+        .collect();
     if !incomplete.is_empty() || !failed.is_empty() {
         let mut what = Vec::new();
         if !incomplete.is_empty() {
             what.push(format!("{} level(s) did not cross the band (their points are written)", incomplete.len()));
         }
         if !failed.is_empty() {
-            what.push(format!("{} snapshot(s) failed", failed.len()));
+            what.push(format!("{} snapshot(s) or grid level(s) failed", failed.len()));
         }
         anyhow::bail!(
             "{}:\n  {}",

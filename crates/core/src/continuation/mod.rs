@@ -50,7 +50,8 @@
 //!   predicted last iterate is checked with a residual alone, saving the Jacobian at the
 //!   solution that only the tangent predictor uses.
 //! - **ACCEPT-REJECT**: a correction is rejected when Newton fails (no convergence within
-//!   `max_iterations`, a non-finite residual or a singular bordered matrix), when the corrector
+//!   `max_iterations`, a non-finite residual, a singular bordered matrix, or a problem that
+//!   cannot be evaluated at a trial iterate, [`ProblemError::at_trial_iterate`]), when the corrector
 //!   travelled farther than the step itself (a jump to another part of the curve) or when the
 //!   secant turned by more than `max_angle` from the previous one (a fold taken too coarsely).
 //!   Friction makes branches only piecewise smooth (a stick/slip transition is a corner): a
@@ -156,11 +157,21 @@ pub struct Scales {
 #[error("{message}")]
 pub struct ProblemError {
     pub message: String,
+    /// The problem cannot be evaluated at this iterate only (e.g. an element whose law has no
+    /// periodic regime for a wild trial motion): the step is rejected and retried shorter,
+    /// instead of ending the branch. At the first point it ends the branch all the same.
+    pub at_trial_iterate: bool,
 }
 
 impl ProblemError {
+    /// An error that ends the continuation.
     pub fn new(message: impl Into<String>) -> Self {
-        ProblemError { message: message.into() }
+        ProblemError { message: message.into(), at_trial_iterate: false }
+    }
+
+    /// An error at a trial iterate: the step is rejected ([`Rejection::TrialIterateFailed`]).
+    pub fn at_trial_iterate(message: impl Into<String>) -> Self {
+        ProblemError { message: message.into(), at_trial_iterate: true }
     }
 }
 
@@ -343,6 +354,8 @@ pub enum Rejection {
     WentBack,
     /// The solve at exactly the end of the interval did not converge.
     EndSolveFailed,
+    /// The problem could not be evaluated at a trial iterate ([`ProblemError::at_trial_iterate`]).
+    TrialIterateFailed,
 }
 
 impl std::fmt::Display for Rejection {
@@ -358,6 +371,10 @@ impl std::fmt::Display for Rejection {
             Rejection::TurnedTooSharply => "the branch turned by more than the largest angle",
             Rejection::WentBack => "the first step went back past the start of the interval",
             Rejection::EndSolveFailed => "the solve at the end of the interval did not converge",
+            Rejection::TrialIterateFailed => {
+                "the problem could not be evaluated at a trial iterate (e.g. an element with no periodic regime \
+                 for the trial motion)"
+            }
         })
     }
 }
@@ -369,6 +386,10 @@ pub struct Branch {
     pub termination: TerminationReason,
     /// All calls, rejected attempts included.
     pub calls: Calls,
+    /// The residual scale `s_R` (see "Scaled variables"): Newton converges when
+    /// `‖R‖ ≤ max(rtol s_R, atol)`, so `Point::residual_norm / residual_scale` is the measure the
+    /// tolerance applies to.
+    pub residual_scale: f64,
 }
 
 /// Receives every converged point as it is accepted.

@@ -44,7 +44,7 @@ pub fn continue_branch<P: Problem + ?Sized, O: Observer + ?Sized>(
     runner.scale.x = scales.unknowns.unwrap_or_else(|| positive_or_one(norm(x_guess)));
     let mut points = Vec::new();
     let termination = runner.run(x_guess, scales.residual, observer, &mut points);
-    Ok(Branch { points, termination, calls: runner.total })
+    Ok(Branch { points, termination, calls: runner.total, residual_scale: runner.scale.residual })
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -185,6 +185,8 @@ struct Runner<'a, P: ?Sized> {
     /// the first point), for the angle check; and the tangent at the last point.
     previous_direction: Vec<f64>,
     tangent: Vec<f64>,
+    /// The last error at a trial iterate, and where.
+    trial_error: Option<(f64, ProblemError)>,
 }
 
 impl<'a, P: Problem + ?Sized> Runner<'a, P> {
@@ -213,6 +215,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             x_phys: vec![0.0; n],
             previous_direction: zeros.clone(),
             tangent: zeros,
+            trial_error: None,
         }
     }
 
@@ -233,6 +236,10 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let (iterations, residual_norm) =
             match self.newton(Constraint::FixedLambda(self.lambda_start), options.first_point_max_iterations, true) {
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
+                Outcome::Failed { cause: Rejection::TrialIterateFailed, .. } => {
+                    let (lambda, error) = self.trial_error.take().expect("a trial iterate's error is kept");
+                    return TerminationReason::ProblemError { lambda, last_lambda: None, error };
+                }
                 Outcome::Failed { iterations, residual_norm, .. } => {
                     return TerminationReason::FirstPointFailed { lambda: self.lambda_start, residual_norm, iterations }
                 }
@@ -406,6 +413,17 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         1.0
     }
 
+    /// A problem error in Newton: a rejection if it is at a trial iterate (kept, to be reported
+    /// if the first point fails on it), else the end of the branch.
+    fn problem_outcome(&mut self, iterations: usize, lambda: f64, error: ProblemError) -> Outcome {
+        if error.at_trial_iterate {
+            self.trial_error = Some((lambda, error));
+            Outcome::Failed { iterations, residual_norm: f64::INFINITY, cause: Rejection::TrialIterateFailed }
+        } else {
+            Outcome::Problem { lambda, error }
+        }
+    }
+
     /// The tangent at `last` from the Jacobian evaluated there, oriented along the previous
     /// step (physical units, in `tangent`); false if it cannot be computed.
     fn tangent_by_jacobian(&mut self, last: &Point) -> bool {
@@ -542,12 +560,12 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 match self.evaluate(lambda, false) {
                     Ok(r) if r <= self.tolerance => return Outcome::Converged { iterations, residual_norm: r },
                     Ok(_) => {}
-                    Err(error) => return Outcome::Problem { lambda, error },
+                    Err(error) => return self.problem_outcome(iterations, lambda, error),
                 }
             }
             let residual_norm = match self.evaluate(lambda, true) {
                 Ok(r) => r,
-                Err(error) => return Outcome::Problem { lambda, error },
+                Err(error) => return self.problem_outcome(iterations, lambda, error),
             };
             if !residual_norm.is_finite() {
                 return Outcome::Failed { iterations, residual_norm, cause: Rejection::Singular };

@@ -44,7 +44,7 @@ impl Problem for FrequencySweep<'_, '_> {
         jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
     ) -> Result<(), ProblemError> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: Some(dl), dlevel: None });
-        self.hbm.evaluate(x, omega, self.level, residual, jac).map_err(|e| ProblemError::new(e.to_string()))
+        self.hbm.evaluate(x, omega, self.level, residual, jac).map_err(problem_error)
     }
 }
 
@@ -61,7 +61,16 @@ impl Problem for LevelSweep<'_, '_> {
         jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
     ) -> Result<(), ProblemError> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: None, dlevel: Some(dl) });
-        self.hbm.evaluate(x, self.omega, level, residual, jac).map_err(|e| ProblemError::new(e.to_string()))
+        self.hbm.evaluate(x, self.omega, level, residual, jac).map_err(problem_error)
+    }
+}
+
+/// An element that fails on a trial motion (no periodic regime, a non-finite force) rejects
+/// the step, which is retried shorter; any other error ends the branch.
+fn problem_error(e: HbmError) -> ProblemError {
+    match e {
+        HbmError::Aft(_) => ProblemError::at_trial_iterate(e.to_string()),
+        _ => ProblemError::new(e.to_string()),
     }
 }
 

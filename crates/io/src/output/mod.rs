@@ -143,13 +143,13 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 /// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`,
 /// `peaks.csv` (see [`write_peaks_csv`]), the
 /// time data of the points that carry it (`points/`), and one FRF plot per output
-/// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`]. Returns the
-/// paths of the FRF table, the NPZ file and the plots.
+/// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`], unless `plots`
+/// is `None` (batch runs). Returns the paths of the FRF table, the NPZ file and the plots.
 #[cfg(feature = "plot")]
 pub fn write_results(
     dir: &std::path::Path,
     levels: &[LevelResult],
-    plot_format: PlotFormat,
+    plots: Option<PlotFormat>,
 ) -> Result<Vec<PathBuf>, OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
@@ -159,27 +159,30 @@ pub fn write_results(
     write_peaks_csv(&peaks, &crate::report::peaks(levels))?;
     let mut files = vec![csv, npz, peaks];
     write_time_data(dir, levels)?;
-    files.extend(crate::plot::plot_frfs(dir, levels, plot_format)?);
-    files.extend(crate::plot::plot_level_details(dir, levels, plot_format)?);
+    if let Some(format) = plots {
+        files.extend(crate::plot::plot_frfs(dir, levels, format)?);
+        files.extend(crate::plot::plot_level_details(dir, levels, format)?);
+    }
     Ok(files)
 }
 
 /// Write each snapshot's time signals, `snapshot<i>.csv` (i from 0, in the study's order), and
-/// per joint with both sides known the plot of their velocities, `snapshot<i>_<joint>.<ext>`.
-/// Returns the files written.
+/// per joint with both sides known the plot of their velocities, `snapshot<i>_<joint>.<ext>`
+/// (unless `plots` is `None`). Returns the files written.
 #[cfg(feature = "plot")]
 pub fn write_snapshots(
     dir: &Path,
     snapshots: &[SnapshotResult],
-    plot_format: PlotFormat,
+    plots: Option<PlotFormat>,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let mut files = Vec::new();
     for (i, s) in snapshots.iter().enumerate() {
         let csv = dir.join(format!("snapshot{i}.csv"));
         write_snapshot_csv(&csv, s)?;
         files.push(csv);
+        let Some(format) = plots else { continue };
         for sides in &s.sides {
-            let path = dir.join(format!("snapshot{i}_{}.{}", sides.joint, plot_format.extension()));
+            let path = dir.join(format!("snapshot{i}_{}.{}", sides.joint, format.extension()));
             crate::plot::plot_joint_sides(&path, s, sides)?;
             files.push(path);
         }

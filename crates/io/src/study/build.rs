@@ -402,7 +402,14 @@ impl Study {
                 Box::new(RegularizedCoulomb::new(*threshold, *velocity_scale).map_err(element_error)?)
             }
             LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
-            LawSpec::Contact { tangential, normal, preload, normal_stiffness, tangential_stiffness, friction } => {
+            LawSpec::Contact(ContactSpec {
+                tangential,
+                normal,
+                preload,
+                normal_stiffness,
+                tangential_stiffness,
+                friction,
+            }) => {
                 // Directions tangential first, then normal, as the element expects; a pair is
                 // U_a − U_b (no normalisation: the stiffnesses act on that difference).
                 let directions =
@@ -630,10 +637,27 @@ fn sanitized(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
 }
 
+/// DOF names, one per line; or the `dofs.csv` that `stickslip reduce` writes (a CSV table with
+/// a header, the names in its `name` column), so that a reduced model is read as written.
 fn read_dof_file(path: &Path) -> Result<Vec<DofLabel>, StudyErrorKind> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| StudyErrorKind::Invalid(format!("[model] dof_file: cannot read {}: {e}", path.display())))?;
-    Ok(text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')).map(dof_label).collect())
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')).peekable();
+    let column = lines.peek().and_then(|header| header.split(',').position(|c| c.trim() == "name"));
+    let Some(column) = column else { return Ok(lines.map(dof_label).collect()) };
+    lines
+        .skip(1)
+        .enumerate()
+        .map(|(i, l)| match l.split(',').nth(column).map(str::trim) {
+            Some(name) if !name.is_empty() => Ok(dof_label(name)),
+            _ => Err(StudyErrorKind::Invalid(format!(
+                "[model] dof_file: {}: row {} has no value in the `name` column (column {})",
+                path.display(),
+                i + 1,
+                column + 1
+            ))),
+        })
+        .collect()
 }
 
 fn read_matrix(path: &Path, context: &str) -> Result<Matrix, StudyErrorKind> {

@@ -41,6 +41,9 @@ pub struct Study {
     pub output_options: OutputOptions,
     /// Periodic responses asked at fixed (frequency, level) pairs, besides the sweeps.
     pub snapshots: Vec<Snapshot>,
+    /// `[grid] frequencies_hz`: frequencies (Hz) solved one by one at every level, besides the
+    /// sweeps (empty: none).
+    pub grid_hz: Vec<f64>,
 }
 
 /// Line and column (both from 1) of a key in the study file.
@@ -171,33 +174,24 @@ pub enum JointStiffness {
 /// The law of a joint and its parameters (SI).
 #[derive(Clone, Debug, PartialEq)]
 pub enum LawSpec {
-    Jenkins {
-        threshold: f64,
-        stiffness: JointStiffness,
-    },
-    Iwan {
-        stiffness: JointStiffness,
-        slip_force: f64,
-        sliders: usize,
-    },
-    Coulomb {
-        threshold: f64,
-        velocity_scale: f64,
-    },
-    Cubic {
-        k3: f64,
-    },
-    /// Point contact (`contact2d`: one tangential direction, `contact3d`: two), standalone:
-    /// the joint adds its own stiffnesses. The joint's `placement` is its first tangential
-    /// direction; `tangential` holds all of them, `normal` the normal approach.
-    Contact {
-        tangential: Vec<Placement>,
-        normal: Placement,
-        preload: f64,
-        normal_stiffness: f64,
-        tangential_stiffness: f64,
-        friction: f64,
-    },
+    Jenkins { threshold: f64, stiffness: JointStiffness },
+    Iwan { stiffness: JointStiffness, slip_force: f64, sliders: usize },
+    Coulomb { threshold: f64, velocity_scale: f64 },
+    Cubic { k3: f64 },
+    Contact(ContactSpec),
+}
+
+/// A point contact (`contact2d`: one tangential direction, `contact3d`: two), standalone: the
+/// joint adds its own stiffnesses. The joint's `placement` is its first tangential direction;
+/// `tangential` holds all of them, `normal` the normal approach.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactSpec {
+    pub tangential: Vec<Placement>,
+    pub normal: Placement,
+    pub preload: f64,
+    pub normal_stiffness: f64,
+    pub tangential_stiffness: f64,
+    pub friction: f64,
 }
 
 /// A joint: a nonlinear element on an application vector.

@@ -27,6 +27,7 @@ pub(crate) struct RawStudy {
     pub output_options: Option<S<RawOutputOptions>>,
     #[serde(default)]
     pub snapshot: Vec<S<RawSnapshot>>,
+    pub grid: Option<S<RawGrid>>,
 }
 
 /// A matrix written inline: a list of rows, or a list of diagonal values.
@@ -176,6 +177,13 @@ pub(crate) struct RawOutput {
 pub(crate) struct RawSnapshot {
     pub frequency_hz: S<f64>,
     pub level: S<f64>,
+}
+
+/// `[grid]`: frequencies solved one by one at every level.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawGrid {
+    pub frequencies_hz: S<Vec<f64>>,
 }
 
 /// `time_data = "none" | "all"` or an integer k (every k-th point).
