@@ -24,6 +24,7 @@ fn _stickslip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<study::PyStudy>()?;
     m.add_class::<params::PyParamDesign>()?;
     m.add_function(wrap_pyfunction!(tools::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::reduce, m)?)?;
     m.add_function(wrap_pyfunction!(tools::extract, m)?)?;
     m.add("SUMMARY_COLUMNS", stickslip_io::params::files::SUMMARY_COLUMNS.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,10 +1,13 @@
 //! `ParamDesign`: a study, its varied keys and its samples (`stickslip_io::params`), and the
 //! runs of batches of samples as plain data for the Python scheduler (processes or Dask).
 
+use std::sync::Mutex;
+
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use stickslip_io::params::{files, ParamError as IoParamError, ParamStudy, SampleOutcome, Vary};
+use stickslip_io::params::{files, ParamError as IoParamError, ParamStudy, SampleOutcome, SampleRunner, Vary};
+use stickslip_io::study::LinearBase;
 
 use crate::convert::{guarded, table_from_dict, ParamError, StudyError};
 use crate::study::PyStudy;
@@ -21,6 +24,9 @@ fn param_error(e: IoParamError) -> PyErr {
 #[pyclass(module = "stickslip._stickslip", name = "ParamDesign", frozen)]
 pub struct PyParamDesign {
     inner: ParamStudy,
+    /// Linear models (or their reductions) built by earlier batches, one per batch that ran at
+    /// the same time: a worker's next batch starts from one instead of rebuilding it.
+    bases: Mutex<Vec<LinearBase>>,
 }
 
 #[pymethods]
@@ -34,7 +40,7 @@ impl PyParamDesign {
         guarded(|| {
             let varies = varies.iter().map(|v| Vary::parse(v)).collect::<Result<Vec<_>, _>>().map_err(param_error)?;
             let inner = ParamStudy::new(table, path, &varies, samples, seed).map_err(param_error)?;
-            Ok(PyParamDesign { inner })
+            Ok(PyParamDesign { inner, bases: Mutex::new(Vec::new()) })
         })
     }
 
@@ -45,7 +51,7 @@ impl PyParamDesign {
         let (table, path) = table_and_path(study)?;
         guarded(|| {
             let inner = ParamStudy::with_samples(table, path, &keys, samples).map_err(param_error)?;
-            Ok(PyParamDesign { inner })
+            Ok(PyParamDesign { inner, bases: Mutex::new(Vec::new()) })
         })
     }
 
@@ -101,9 +107,21 @@ impl PyParamDesign {
         if let Some(i) = indices.iter().find(|i| **i >= self.inner.samples.len()) {
             return Err(self.out_of_range(*i));
         }
-        let inner = &self.inner;
+        let (inner, bases) = (&self.inner, &self.bases);
         let outcomes: Vec<SampleOutcome> = py.detach(|| {
-            guarded(|| Ok(indices.iter().map(|&i| inner.run_sample(i, output.as_deref(), curves)).collect()))
+            guarded(|| {
+                // The samples share the linear model (and its reduction) while their varied
+                // keys leave it unchanged (see `SampleRunner`), within a batch and across the
+                // batches a worker runs. A poisoned lock only means a batch panicked; the
+                // bases it holds are whole values.
+                let kept = bases.lock().unwrap_or_else(|e| e.into_inner()).pop();
+                let mut runner = SampleRunner::with_base(inner, kept);
+                let outcomes = indices.iter().map(|&i| runner.run(i, output.as_deref(), curves)).collect();
+                if let Some(base) = runner.into_base() {
+                    bases.lock().unwrap_or_else(|e| e.into_inner()).push(base);
+                }
+                Ok(outcomes)
+            })
         })?;
         outcomes.iter().map(|o| outcome_dict(py, o)).collect()
     }

@@ -1,10 +1,13 @@
-//! Functions on NumPy inputs: modes of a pair of matrices, harmonics of time records.
+//! Functions on NumPy inputs: modes and reductions of a pair of matrices, harmonics of time
+//! records.
 
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix};
 use stickslip_core::signal::harmonics::{extract as extract_blocks, SyncOptions};
+use stickslip_fe::eigen::EigenOptions;
+use stickslip_fe::reduction::{self, ReductionOptions, Release};
 
 use crate::convert::{chain, guarded, InputError, SolveError};
 
@@ -29,20 +32,8 @@ fn vector<'py>(a: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArray1<'
     })
 }
 
-/// Frequencies (Hz) and mode shapes (one column per mode).
-type FrequenciesAndShapes<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
-
-/// Undamped modes of `(K, M)` by a dense generalised symmetric eigensolution (for small or
-/// reduced models): returns `(frequencies_hz, shapes)` with shapes mass-normalised, one column
-/// per mode, lowest first; `count` keeps the lowest `count` modes.
-#[pyfunction]
-#[pyo3(signature = (mass, stiffness, count=None))]
-pub fn modes<'py>(
-    py: Python<'py>,
-    mass: &Bound<'py, PyAny>,
-    stiffness: &Bound<'py, PyAny>,
-    count: Option<usize>,
-) -> PyResult<FrequenciesAndShapes<'py>> {
+/// `mass` and `stiffness` as dense matrices of the same square size (at least 1x1).
+fn square_pair(mass: &Bound<'_, PyAny>, stiffness: &Bound<'_, PyAny>) -> PyResult<(faer::Mat<f64>, faer::Mat<f64>)> {
     let (m, k) = (matrix(mass, "mass")?, matrix(stiffness, "stiffness")?);
     let n = m.shape()[0];
     for (name, a) in [("mass", &m), ("stiffness", &k)] {
@@ -61,7 +52,116 @@ pub fn modes<'py>(
         let v = a.as_array();
         faer::Mat::from_fn(n, n, |i, j| v[(i, j)])
     };
-    let (m, k) = (to_mat(&m), to_mat(&k));
+    Ok((to_mat(&m), to_mat(&k)))
+}
+
+fn to_numpy<'py>(py: Python<'py>, a: &faer::Mat<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    if a.nrows() == 0 || a.ncols() == 0 {
+        return Ok(PyArray2::zeros(py, [a.nrows(), a.ncols()], false));
+    }
+    let rows: Vec<Vec<f64>> = (0..a.nrows()).map(|i| (0..a.ncols()).map(|j| a[(i, j)]).collect()).collect();
+    Ok(PyArray2::from_vec2(py, &rows)?)
+}
+
+/// Reduction of `(M, K)` to the physical DOFs `retained` (indices) plus `modes` modal
+/// coordinates (paper Section 3.3), as `[reduction]` does in a study: `method` "cb"
+/// (Craig-Bampton: constraint modes, Eqs. 3-4, + fixed-interface modes), "free" (the paper's
+/// variant: free modes cleaned on the retained DOFs, Eq. 5) or "enriched" ("free" plus the
+/// `release_modes` lowest modes with the `releases` removed from K: a list of
+/// `(direction, stiffness)`, `stiffness · d dᵀ` being the connector a joint replaces).
+/// Returns a dict: `mass` and `stiffness` (`Tᵀ M T`, `Tᵀ K T`), `basis` (`T`, full DOFs x
+/// reduced DOFs, with `U = T q`), `retained` (reduced-DOF order) and `frequencies_hz` of the
+/// modes put in the basis.
+#[pyfunction]
+#[pyo3(signature = (mass, stiffness, retained, modes, method="cb", releases=None, release_modes=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn reduce<'py>(
+    py: Python<'py>,
+    mass: &Bound<'py, PyAny>,
+    stiffness: &Bound<'py, PyAny>,
+    retained: Vec<usize>,
+    modes: usize,
+    method: &str,
+    releases: Option<Vec<(Bound<'py, PyAny>, f64)>>,
+    release_modes: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (m, k) = square_pair(mass, stiffness)?;
+    let n = m.nrows();
+    let releases = releases
+        .unwrap_or_default()
+        .iter()
+        .enumerate()
+        .map(|(i, (d, stiffness))| {
+            let name = format!("releases[{i}]");
+            let direction = vector(d, &name)?.as_array().to_vec();
+            if direction.len() != n {
+                return Err(InputError::new_err(format!(
+                    "{name}: direction has {} values, expected {n} (one per DOF)",
+                    direction.len()
+                )));
+            }
+            Ok(Release { name, direction, stiffness: *stiffness })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    match method {
+        "cb" | "free" if !releases.is_empty() || release_modes > 0 => {
+            return Err(InputError::new_err(format!(
+                "releases and release_modes go with method=\"enriched\", got method={method:?}"
+            )))
+        }
+        "cb" | "free" => {}
+        "enriched" if releases.is_empty() || release_modes == 0 => {
+            return Err(InputError::new_err(
+                "method=\"enriched\" needs releases (a list of (direction, stiffness)) and release_modes >= 1",
+            ))
+        }
+        "enriched" => {}
+        other => {
+            return Err(InputError::new_err(format!(
+                "method: unknown method {other:?}, expected \"cb\" (Craig-Bampton), \"free\" (free modes, the paper's) or \"enriched\""
+            )))
+        }
+    }
+    let method = method.to_string();
+    let red = py.detach(|| {
+        guarded(|| {
+            let dofs = (0..n).map(|i| DofLabel::named(format!("{}", i + 1))).collect();
+            let model = LinearModel::new(Matrix::Dense(m), Matrix::Dense(k), Damping::None, dofs, Vec::new())
+                .map_err(|e| InputError::new_err(chain(&e)))?;
+            let options = ReductionOptions { retained, modes, eigen: EigenOptions::default() };
+            match method.as_str() {
+                "cb" => reduction::craig_bampton(&model, &options),
+                "free" => reduction::free_modes(&model, &options),
+                _ => reduction::enriched(&model, &options, &releases, release_modes),
+            }
+            .map_err(|e| SolveError::new_err(chain(&e)))
+        })
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("mass", to_numpy(py, &red.model.mass.to_dense())?)?;
+    d.set_item("stiffness", to_numpy(py, &red.model.stiffness.to_dense())?)?;
+    d.set_item("basis", to_numpy(py, &red.basis)?)?;
+    d.set_item("retained", red.retained.clone())?;
+    d.set_item("frequencies_hz", PyArray1::from_vec(py, red.basis_frequencies_hz.clone()))?;
+    Ok(d)
+}
+
+/// Frequencies (Hz) and mode shapes (one column per mode).
+type FrequenciesAndShapes<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// Undamped modes of `(K, M)` by a dense generalised symmetric eigensolution (for small or
+/// reduced models): returns `(frequencies_hz, shapes)` with shapes mass-normalised, one column
+/// per mode, lowest first; `count` keeps the lowest `count` modes.
+#[pyfunction]
+#[pyo3(signature = (mass, stiffness, count=None))]
+pub fn modes<'py>(
+    py: Python<'py>,
+    mass: &Bound<'py, PyAny>,
+    stiffness: &Bound<'py, PyAny>,
+    count: Option<usize>,
+) -> PyResult<FrequenciesAndShapes<'py>> {
+    let (m, k) = square_pair(mass, stiffness)?;
+    let n = m.nrows();
     let result = py.detach(|| {
         guarded(|| {
             let dofs = (0..n).map(|i| DofLabel::named(format!("{}", i + 1))).collect();

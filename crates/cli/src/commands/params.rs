@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::Context;
 use rayon::prelude::*;
 use stickslip_io::params::files::{merge, write_curves, write_shard, Shard};
-use stickslip_io::params::{ParamStudy, SampleOutcome, Vary};
+use stickslip_io::params::{ParamStudy, SampleOutcome, SampleRunner, Vary};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -52,17 +52,21 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let total = range.len();
     let outcomes: Vec<SampleOutcome> = range
         .into_par_iter()
-        .map(|i| {
-            let o = study.run_sample(i, args.output.as_deref(), args.curves);
-            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if !args.quiet {
-                match &o.error {
-                    None => eprintln!("[{n}/{total}] sample {i} done"),
-                    Some(e) => eprintln!("[{n}/{total}] sample {i} failed: {e}"),
+        // A runner per rayon job keeps the linear model (and its reduction) of its samples.
+        .map_init(
+            || SampleRunner::new(&study),
+            |runner, i| {
+                let o = runner.run(i, args.output.as_deref(), args.curves);
+                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                if !args.quiet {
+                    match &o.error {
+                        None => eprintln!("[{n}/{total}] sample {i} done"),
+                        Some(e) => eprintln!("[{n}/{total}] sample {i} failed: {e}"),
+                    }
                 }
-            }
-            o
-        })
+                o
+            },
+        )
         .collect();
     for o in &outcomes {
         write_curves(&args.out, o)?;

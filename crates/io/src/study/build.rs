@@ -37,6 +37,43 @@ pub struct OutputSpec {
 /// Largest model for which outputs default to every DOF when no `[[output]]` is given.
 const MAX_DEFAULT_OUTPUTS: usize = 20;
 
+/// What a study's linear base depends on: the model, the reduction, a damping matrix and,
+/// for the enriched reduction, the joints it releases (name, placement, replaced stiffness).
+/// Everything else — joint laws and thresholds, a joint's own stiffness, Rayleigh or modal
+/// damping, loads, excitation levels, outputs, sweep, harmonic balance and continuation
+/// settings — is applied on top of the base.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearPart {
+    model: ModelSpec,
+    reduction: Option<ReductionSpec>,
+    damping_matrix: Option<DampingSpec>,
+    releases: Vec<(String, Placement, JointStiffness)>,
+}
+
+/// The linear model the nonlinear analysis runs on (the model as given, or its reduction),
+/// before loads, joints and outputs are put on it, with the full model's DOF names (which
+/// loads, joints and outputs name) and the reduction that projects their vectors.
+#[derive(Clone, Debug)]
+pub struct LinearBase {
+    full_dofs: Vec<DofLabel>,
+    linear: LinearModel,
+    reduction: Option<Reduction>,
+    model_at: ModelLocations,
+    part: LinearPart,
+}
+
+impl LinearBase {
+    /// The study inputs the base was built from.
+    pub fn part(&self) -> &LinearPart {
+        &self.part
+    }
+
+    /// Number of DOFs of the analysed (possibly reduced) model.
+    pub fn n_dofs(&self) -> usize {
+        self.linear.n_dofs()
+    }
+}
+
 impl Study {
     /// Read the matrix files (if any), check the model (sizes, symmetry, M positive definite by
     /// a Cholesky factorisation) and build the nonlinear model, the excitation and the outputs.
@@ -63,14 +100,56 @@ impl Study {
         &self,
         timings: &mut Vec<(String, f64)>,
     ) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
+        let base = self.build_linear_base(timings)?;
+        self.build_model_on(&base)
+    }
+
+    /// What of this study its linear base depends on: studies with equal parts can share one
+    /// [`LinearBase`] (see [`Study::build_model_on`]).
+    pub fn linear_part(&self) -> LinearPart {
+        let enriched = matches!(&self.reduction, Some(r) if matches!(r.method, ReductionMethod::Enriched { .. }));
+        // The enriched basis has the modes of the structure with the joints that replace
+        // stiffness released: their directions and the stiffness they remove shape it.
+        let releases = if enriched {
+            self.joints
+                .iter()
+                .filter_map(|j| match &j.law {
+                    LawSpec::Jenkins { stiffness, .. } | LawSpec::Iwan { stiffness, .. } => match stiffness {
+                        JointStiffness::Own(_) => None,
+                        s => Some((j.name.clone(), j.placement.clone(), *s)),
+                    },
+                    _ => None,
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        LinearPart {
+            model: self.model.clone(),
+            reduction: self.reduction.clone(),
+            // Rayleigh and modal damping are descriptions that a reduction carries over
+            // unchanged (Tᵀ(αM + βK)T = αM_r + βK_r; modal ratios apply to the reduced model's
+            // modes): they are set on the base when it is used. A damping matrix is projected
+            // by the reduction, so it belongs to the base.
+            damping_matrix: match &self.damping {
+                d @ (DampingSpec::Matrix(_) | DampingSpec::File(_)) => Some(d.clone()),
+                _ => None,
+            },
+            releases,
+        }
+    }
+
+    /// The linear model the nonlinear analysis runs on, before loads, joints and outputs:
+    /// the model as given or its reduction (mesh, assembly, modes and reduction are timed in
+    /// `timings`).
+    pub fn build_linear_base(&self, timings: &mut Vec<(String, f64)>) -> Result<LinearBase, StudyError> {
         let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
-        let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
         let (full, model_at) = self.full_model(timings)?;
         // Reduction (Section 3.3): the nonlinear analysis runs on the reduced model; loads,
         // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
         // u = Vᵀ U = (Tᵀ V)ᵀ q).
         let full_dofs = full.linear().dofs.clone();
-        let (mut linear, reduction) = match &self.reduction {
+        let (linear, reduction) = match &self.reduction {
             None => (full.into_linear(), None),
             Some(r) => {
                 let releases = self.releases(full.linear())?;
@@ -81,7 +160,36 @@ impl Study {
                 (red.model.clone(), Some(red))
             }
         };
-        let space = DofSpace { dofs: &full_dofs, reduction: reduction.as_ref() };
+        Ok(LinearBase { full_dofs, linear, reduction, model_at, part: self.linear_part() })
+    }
+
+    /// The nonlinear model, excitation and outputs of this study on a linear base built by a
+    /// study with the same [`LinearPart`] (this one or another sample of a parameter study):
+    /// the same result as [`Study::build_model`], without rebuilding the linear model.
+    ///
+    /// # Panics
+    /// If `base` was built from a study with another linear part (a misuse: compare
+    /// [`Study::linear_part`] with [`LinearBase::part`] first).
+    pub fn build_model_on(
+        &self,
+        base: &LinearBase,
+    ) -> Result<(NonlinearModel, Excitation, Vec<OutputSpec>), StudyError> {
+        assert!(
+            base.part == self.linear_part(),
+            "expected a linear base built from the same model, reduction and damping matrix"
+        );
+        let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
+        let model_error = |source: ModelError| StudyErrorKind::Model { context: "[model]".into(), source };
+        let model_at = base.model_at;
+        let mut linear = base.linear.clone();
+        match &self.damping {
+            DampingSpec::None => linear.damping = Damping::None,
+            DampingSpec::Rayleigh { alpha, beta } => linear.damping = Damping::Rayleigh { alpha: *alpha, beta: *beta },
+            DampingSpec::Modal { ratios } => linear.damping = Damping::Modal { ratios: ratios.clone() },
+            // Part of the base (equal by the assertion above).
+            DampingSpec::Matrix(_) | DampingSpec::File(_) => {}
+        }
+        let space = DofSpace { dofs: &base.full_dofs, reduction: base.reduction.as_ref() };
 
         for l in &self.loads {
             let ctx = format!("[[load]] {:?}", l.name);

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use faer::Mat;
 
-pub use build::{Excitation, OutputSpec};
+pub use build::{Excitation, LinearBase, LinearPart, OutputSpec};
 pub use stickslip_core::model::NonlinearModel;
 
 /// A validated study.
@@ -54,7 +54,9 @@ pub struct Location {
 }
 
 /// Where the linear model comes from.
-#[derive(Clone, Debug)]
+// Compared (with the reduction and a damping matrix) to decide whether two studies share
+// their linear model: see `Study::linear_part`.
+#[derive(Clone, Debug, PartialEq)]
 pub enum ModelSpec {
     /// Small matrices written in the study file (kg, N/m), with their DOF names.
     Inline { dofs: Vec<String>, mass: Mat<f64>, stiffness: Mat<f64>, at: ModelLocations },
@@ -111,7 +113,7 @@ pub struct ModelLocations {
 }
 
 /// DOF names of a model read from files.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum DofNames {
     Numbered,
     Inline(Vec<String>),
@@ -119,7 +121,7 @@ pub enum DofNames {
 }
 
 /// Viscous damping of the linear model.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum DampingSpec {
     None,
     /// `D = α M + β K` (α in 1/s, β in s; the paper uses `D = α M`).
@@ -193,7 +195,7 @@ pub struct ContactSpec {
 }
 
 /// A joint: a nonlinear element on an application vector.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct JointSpec {
     pub name: String,
     pub law: LawSpec,

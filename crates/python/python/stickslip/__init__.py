@@ -22,6 +22,7 @@ from ._stickslip import (
     __version__,
     extract,
     modes,
+    reduce,
 )
 from ._study import Results, Study
 from .params import ParamResults, design, run_parameters
@@ -40,5 +41,6 @@ __all__ = [
     "design",
     "extract",
     "modes",
+    "reduce",
     "run_parameters",
 ]
