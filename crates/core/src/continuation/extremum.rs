@@ -102,7 +102,12 @@ pub fn maximise_along<P: Problem>(
             }
             let lambda = z[n] * lambda_scale;
             let (residual, jx, jl) = workspace.evaluation_buffers();
-            problem.evaluate(&x, lambda, residual, Some((jx, jl)))?;
+            match problem.evaluate(&x, lambda, residual, Some((jx, jl))) {
+                Ok(()) => {}
+                // A law that fails on this iterate: the point cannot be solved, not the search.
+                Err(e) if e.at_trial_iterate => return Ok(false),
+                Err(e) => return Err(e),
+            }
             if residual_scale == 0.0 {
                 residual_scale = workspace.dr_dlambda.iter().map(|v| v * v).sum::<f64>().sqrt() * lambda_scale;
                 if !(residual_scale.is_finite() && residual_scale > 0.0) {
