@@ -3,37 +3,10 @@
 //! once per branch). Counted by a global allocator, in its own test binary.
 
 use faer::MatMut;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use stickslip_core::continuation::{continue_branch, Options, Predictor, Problem, ProblemError, Silent};
 
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-struct Counting;
-
-// SAFETY: forwards to the system allocator; only counts the calls made by the current thread.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
+mod allocation_counter;
+use allocation_counter::allocations;
 
 /// First-order harmonic balance of a Duffing oscillator (see continuation_duffing.rs) that
 /// records the allocation count at every evaluation, in a buffer reserved beforehand.
