@@ -131,11 +131,12 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
-        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, plots, points/)",
+        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, peaks.csv{}, points/)",
         levels.len(),
         elapsed.as_secs_f64(),
         files.len(),
-        args.out.display()
+        args.out.display(),
+        if args.no_plots { "" } else { ", plots" }
     );
     if !args.no_report {
         let data = stickslip_io::analysis::report_data(&study, &model, &excitation, &runs, &files, timings.clone());
