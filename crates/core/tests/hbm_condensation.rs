@@ -1,11 +1,9 @@
 //! The condensed balance (Eqs. 20-29) has the same solution as the full one (Eq. 16).
 mod hbm_support;
 
-use faer::linalg::solvers::Solve;
-use faer::Mat;
 use hbm_support::*;
 use stickslip_core::elements::{Element, Iwan, Jenkins};
-use stickslip_core::hbm::{CondensedHbm, FullHbm, HbmSettings};
+use stickslip_core::hbm::{CondensedHbm, HbmSettings};
 use stickslip_core::model::{relative_direction, Damping};
 use stickslip_core::post::{evaluate_point, OutputSelector};
 
@@ -42,25 +40,7 @@ fn condensed_solution_equals_the_full_solution_on_20_dofs_with_3_elements() {
         let nc = 2 * settings.harmonics + 1;
         let recovered: Vec<f64> = (0..nc * n).map(|idx| p.outputs[idx % n].coeffs[idx / n]).collect();
         // ... perturbed by 1 % and corrected by Newton on the full (2N+1)n balance.
-        let mut full = FullHbm::new(&model, &force, settings).unwrap();
-        let dim = full.dimension();
-        let mut x: Vec<f64> = recovered.iter().map(|v| v * 1.01).collect();
-        let mut r = vec![0.0; dim];
-        let mut j = Mat::zeros(dim, dim);
-        for _ in 0..40 {
-            full.evaluate(&x, omega, level, &mut r, Some(j.as_mut())).unwrap();
-            let dx = j.partial_piv_lu().solve(Mat::from_fn(dim, 1, |i, _| r[i]));
-            for i in 0..dim {
-                x[i] -= dx[(i, 0)];
-            }
-            if norm(&(0..dim).map(|i| dx[(i, 0)]).collect::<Vec<_>>()) < 1e-15 * norm(&x) {
-                break;
-            }
-        }
-        full.evaluate(&x, omega, level, &mut r, None).unwrap();
-        assert!(norm(&r) < 1e-9 * level, "full balance not converged: {:.2e}", norm(&r));
-        let diff: Vec<f64> = x.iter().zip(&recovered).map(|(a, b)| a - b).collect();
-        let err = norm(&diff) / norm(&x);
+        let err = full_balance_distance(&model, &force, settings, omega, level, &recovered, 40);
         assert!(err < 1e-8, "condensed vs full: {err:.2e}");
     }
 }

@@ -3,12 +3,11 @@
 //! load, and the condensed balance against the full one with several contacts.
 mod hbm_support;
 
-use faer::linalg::solvers::Solve;
 use faer::Mat;
 use hbm_support::*;
 use stickslip_core::elements::{Contact, Element, Jenkins};
 use stickslip_core::hbm::fourier::{cos_index, sin_index};
-use stickslip_core::hbm::{AftPlan, CondensedHbm, ElementAft, FullHbm, HbmSettings};
+use stickslip_core::hbm::{AftPlan, CondensedHbm, ElementAft, HbmSettings};
 use stickslip_core::model::{relative_direction, Damping, DofLabel, ElementSite, LinearModel, NonlinearModel};
 use stickslip_core::post::{evaluate_point, OutputSelector};
 
@@ -338,27 +337,9 @@ fn condensed_solution_equals_the_full_solution_with_three_contacts() {
         }
         let nc = 2 * settings.harmonics + 1;
         let recovered: Vec<f64> = (0..nc * n).map(|idx| p.outputs[idx % n].coeffs[idx / n]).collect();
-        let mut full = FullHbm::new(&model, &force, settings).unwrap();
-        let dim = full.dimension();
-        let mut x: Vec<f64> = recovered.iter().map(|v| v * 1.01).collect();
-        let mut r = vec![0.0; dim];
-        let mut j = Mat::zeros(dim, dim);
-        for _ in 0..60 {
-            full.evaluate(&x, omega, level, &mut r, Some(j.as_mut())).unwrap();
-            let dx = j.partial_piv_lu().solve(Mat::from_fn(dim, 1, |i, _| r[i]));
-            for i in 0..dim {
-                x[i] -= dx[(i, 0)];
-            }
-            if norm(&(0..dim).map(|i| dx[(i, 0)]).collect::<Vec<_>>()) < 1e-15 * norm(&x) {
-                break;
-            }
-        }
-        full.evaluate(&x, omega, level, &mut r, None).unwrap();
-        assert!(norm(&r) < 1e-9 * level, "full balance not converged: {:.2e}", norm(&r));
         // Both solve the same equations to round-off (condensed to 1e-13 of ‖x‖; measured
         // 3e-15 apart); 1e-8 leaves room for the full solve's conditioning on other machines.
-        let diff: Vec<f64> = x.iter().zip(&recovered).map(|(a, b)| a - b).collect();
-        let err = norm(&diff) / norm(&x);
+        let err = full_balance_distance(&model, &force, settings, omega, level, &recovered, 60);
         println!("condensed vs full: {err:.2e}");
         assert!(err < 1e-8, "condensed vs full: {err:.2e}");
     }
