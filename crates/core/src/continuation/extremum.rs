@@ -68,9 +68,8 @@ pub fn maximise_along<P: Problem>(
         return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
     }
 
-    let mut workspace = Workspace::new(n);
+    let mut path = ChordPath::new(n, &z0, &z1, x_scale, lambda_scale);
     let mut z = vec![0.0; n + 1];
-    let mut x = vec![0.0; n];
     let mut solves = 0;
     // The point at s: from the last point solved if it is near (the scan's neighbours, one or
     // two Newton iterations), else from the parabola through the three points.
@@ -80,7 +79,7 @@ pub fn maximise_along<P: Problem>(
         match &last {
             Some((s_last, z_last)) if (s - s_last).abs() <= 0.02 => {
                 for i in 0..=n {
-                    z[i] = z_last[i] + (s - s_last) * chord[i];
+                    z[i] = z_last[i] + (s - s_last) * path.chord[i];
                 }
             }
             _ => {
@@ -91,52 +90,11 @@ pub fn maximise_along<P: Problem>(
                 }
             }
         }
-        let target: Vec<f64> = z0.iter().zip(&chord).map(|(a, c)| a + s * c).collect();
-        let mut last_step = f64::INFINITY;
-        // Residuals relative to their change across the bracket, ‖∂R/∂λ‖ s_λ (set at the first
-        // evaluation), so that the rows of the bordered matrix are of one magnitude.
-        let mut residual_scale = 0.0;
-        for _ in 0..MAX_ITERATIONS {
-            for (xi, zi) in x.iter_mut().zip(z.iter()) {
-                *xi = zi * x_scale;
-            }
-            let lambda = z[n] * lambda_scale;
-            let (residual, jx, jl) = workspace.evaluation_buffers();
-            match problem.evaluate(&x, lambda, residual, Some((jx, jl))) {
-                Ok(()) => {}
-                // A law that fails on this iterate: the point cannot be solved, not the search.
-                Err(e) if e.at_trial_iterate => return Ok(false),
-                Err(e) => return Err(e),
-            }
-            if residual_scale == 0.0 {
-                residual_scale = workspace.dr_dlambda.iter().map(|v| v * v).sum::<f64>().sqrt() * lambda_scale;
-                if !(residual_scale.is_finite() && residual_scale > 0.0) {
-                    residual_scale = 1.0;
-                }
-            }
-            let constraint: f64 = chord.iter().zip(z.iter().zip(&target)).map(|(c, (a, b))| c * (a - b)).sum();
-            for i in 0..n {
-                workspace.rhs[i] = -workspace.residual[i] / residual_scale;
-            }
-            workspace.rhs[n] = -constraint;
-            if !workspace.residual.iter().all(|r| r.is_finite())
-                || !workspace.solve_bordered(x_scale, lambda_scale, residual_scale, &chord)
-            {
-                return Ok(false);
-            }
-            let step = workspace.rhs.iter().map(|d| d * d).sum::<f64>().sqrt();
-            for (zi, d) in z.iter_mut().zip(&workspace.rhs) {
-                *zi += d;
-            }
-            // Converged to round-off: the update is negligible, or small and no longer shrinking.
-            if step <= 1e-14 * (1.0 + z.iter().map(|v| v * v).sum::<f64>().sqrt()) || (step < 1e-8 && step >= last_step)
-            {
-                last = Some((s, z.clone()));
-                return Ok(true);
-            }
-            last_step = step;
+        let solved = path.solve(problem, s, z)?;
+        if solved {
+            last = Some((s, z.clone()));
         }
-        Ok(false)
+        Ok(solved)
     };
     // The quantity at s; the best point so far is kept.
     let mut best = (f64::NEG_INFINITY, zm.clone());
@@ -191,6 +149,164 @@ pub fn maximise_along<P: Problem>(
         value,
         solves,
     })
+}
+
+/// Locate a zero of `quantity(problem, x, λ)` along the branch of `problem` between two
+/// converged points where it has opposite signs (a Floquet exponent crossing the imaginary
+/// axis: a bifurcation). The branch between them is parametrised as in [`maximise_along`]; the
+/// zero is bracketed by the Illinois variant of regula falsi (superlinear, and never leaves
+/// the bracket), to `tolerance` on `s` (1 = the chord between the two points).
+pub fn zero_along<P: Problem>(
+    problem: &mut P,
+    [before, after]: [&Point; 2],
+    tolerance: f64,
+    mut quantity: impl FnMut(&mut P, &[f64], f64) -> Result<f64, ProblemError>,
+) -> Result<Extremum, ProblemError> {
+    let n = problem.dimension();
+    let x_scale =
+        [before, after].iter().map(|p| p.x.iter().map(|v| v * v).sum::<f64>().sqrt()).fold(f64::MIN_POSITIVE, f64::max);
+    // λ relative to itself (not to its change between the points, as for a peak): a crossing
+    // may sit at a fold, where λ hardly changes while x does, and the hyperplanes orthogonal
+    // to the chord must then cut the branch across x, once.
+    let lambda_scale = before.lambda.abs().max(after.lambda.abs()).max(f64::MIN_POSITIVE);
+    let scaled = |p: &Point| -> Vec<f64> {
+        p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
+    };
+    let (z0, z1) = (scaled(before), scaled(after));
+    let mut path = ChordPath::new(n, &z0, &z1, x_scale, lambda_scale);
+    let (mut a, mut b) = ((0.0, z0.clone()), (1.0, z1.clone()));
+    let mut value = |problem: &mut P, z: &[f64]| {
+        let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
+        quantity(problem, &x, z[n] * lambda_scale)
+    };
+    let (mut fa, mut fb) = (value(problem, &a.1)?, value(problem, &b.1)?);
+    if fa * fb > 0.0 || fa.is_nan() || fb.is_nan() {
+        return Err(ProblemError::new(format!("no sign change between the two points ({fa} and {fb})")));
+    }
+    let mut solves = 0;
+    let mut side = 0i8;
+    let mut z = vec![0.0; n + 1];
+    while (b.0 - a.0) > tolerance && solves < 100 {
+        let s = if fa != fb { (a.0 * fb - b.0 * fa) / (fb - fa) } else { 0.5 * (a.0 + b.0) };
+        // Keep the trial strictly inside the bracket, off its ends by a little of its width.
+        let width = b.0 - a.0;
+        let s = s.clamp(a.0 + 0.01 * width, b.0 - 0.01 * width);
+        for i in 0..=n {
+            let w = (s - a.0) / width;
+            z[i] = (1.0 - w) * a.1[i] + w * b.1[i];
+        }
+        solves += 1;
+        if !path.solve(problem, s, &mut z)? {
+            return Err(ProblemError::new(format!("the branch could not be solved at {s} of the bracket")));
+        }
+        let fs = value(problem, &z)?;
+        if fs == 0.0 {
+            a = (s, z.clone());
+            b = (s, z.clone());
+            break;
+        }
+        // Illinois: the end kept twice in a row has its value halved, so that both ends move.
+        if fs * fb > 0.0 {
+            b = (s, z.clone());
+            fb = fs;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = (s, z.clone());
+            fa = fs;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    // The end nearer the zero (the values may have been halved: compare them afresh).
+    let (za, zb) = (a.1, b.1);
+    let (va, vb) = (value(problem, &za)?, value(problem, &zb)?);
+    let (z, value) = if va.abs() <= vb.abs() { (za, va) } else { (zb, vb) };
+    Ok(Extremum { x: z[..n].iter().map(|v| v * x_scale).collect(), lambda: z[n] * lambda_scale, value, solves })
+}
+
+/// Points of a branch between two of its points `z0` and `z1` (scaled, as the continuation's
+/// variables), parametrised by `s` along their chord `c`: the point at `s` solves `R(x, λ) = 0`
+/// with `cᵀ (z − z0 − s c) = 0` (the corrector of Eq. 32 on the hyperplane orthogonal to the
+/// chord), so that a fold between them is parametrised as well as a plain arc.
+struct ChordPath {
+    n: usize,
+    z0: Vec<f64>,
+    chord: Vec<f64>,
+    x_scale: f64,
+    lambda_scale: f64,
+    workspace: Workspace,
+    x: Vec<f64>,
+}
+
+impl ChordPath {
+    fn new(n: usize, z0: &[f64], z1: &[f64], x_scale: f64, lambda_scale: f64) -> Self {
+        ChordPath {
+            n,
+            z0: z0.to_vec(),
+            chord: z1.iter().zip(z0).map(|(b, a)| b - a).collect(),
+            x_scale,
+            lambda_scale,
+            workspace: Workspace::new(n),
+            x: vec![0.0; n],
+        }
+    }
+
+    /// Solve the point at `s` from the guess in `z`, converged to round-off (Newton until the
+    /// scaled update stops decreasing), into `z`. False if it cannot be solved there.
+    fn solve<P: Problem>(&mut self, problem: &mut P, s: f64, z: &mut [f64]) -> Result<bool, ProblemError> {
+        let n = self.n;
+        let target: Vec<f64> = self.z0.iter().zip(&self.chord).map(|(a, c)| a + s * c).collect();
+        let mut last_step = f64::INFINITY;
+        // Residuals relative to their change across the bracket, ‖∂R/∂λ‖ s_λ (set at the first
+        // evaluation), so that the rows of the bordered matrix are of one magnitude.
+        let mut residual_scale = 0.0;
+        for _ in 0..MAX_ITERATIONS {
+            for (xi, zi) in self.x.iter_mut().zip(z.iter()) {
+                *xi = zi * self.x_scale;
+            }
+            let lambda = z[n] * self.lambda_scale;
+            let (residual, jx, jl) = self.workspace.evaluation_buffers();
+            match problem.evaluate(&self.x, lambda, residual, Some((jx, jl))) {
+                Ok(()) => {}
+                // A law that fails on this iterate: the point cannot be solved, not the search.
+                Err(e) if e.at_trial_iterate => return Ok(false),
+                Err(e) => return Err(e),
+            }
+            let workspace = &mut self.workspace;
+            if residual_scale == 0.0 {
+                residual_scale = workspace.dr_dlambda.iter().map(|v| v * v).sum::<f64>().sqrt() * self.lambda_scale;
+                if !(residual_scale.is_finite() && residual_scale > 0.0) {
+                    residual_scale = 1.0;
+                }
+            }
+            let constraint: f64 = self.chord.iter().zip(z.iter().zip(&target)).map(|(c, (a, b))| c * (a - b)).sum();
+            for i in 0..n {
+                workspace.rhs[i] = -workspace.residual[i] / residual_scale;
+            }
+            workspace.rhs[n] = -constraint;
+            if !workspace.residual.iter().all(|r| r.is_finite())
+                || !workspace.solve_bordered(self.x_scale, self.lambda_scale, residual_scale, &self.chord)
+            {
+                return Ok(false);
+            }
+            let step = workspace.rhs.iter().map(|d| d * d).sum::<f64>().sqrt();
+            for (zi, d) in z.iter_mut().zip(&workspace.rhs) {
+                *zi += d;
+            }
+            // Converged to round-off: the update is negligible, or small and no longer shrinking.
+            if step <= 1e-14 * (1.0 + z.iter().map(|v| v * v).sum::<f64>().sqrt()) || (step < 1e-8 && step >= last_step)
+            {
+                return Ok(true);
+            }
+            last_step = step;
+        }
+        Ok(false)
+    }
 }
 
 /// Brent's method (golden section with parabolic steps) for a maximum of `f` on `[a, b]`, from

@@ -386,6 +386,28 @@ impl<'m> CondensedHbm<'m> {
         Ok(())
     }
 
+    /// `∂G/∂x` at `x` and Ω (q(2N+1) square, coefficient-major as the unknowns): the joints'
+    /// harmonic stiffness, block diagonal over elements, which Hill's method needs assembled
+    /// ([`super::stability`]).
+    pub fn element_force_jacobian(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
+        self.element_forces(x, omega, true)?;
+        let (q, nc) = (self.q, self.plan.n_coeffs());
+        let mut jac = Mat::zeros(q * nc, q * nc);
+        for (e, site) in self.model.elements.iter().enumerate() {
+            let (d, off, je) = (site.law.n_dirs(), self.offsets[e], &self.elem_jac[e]);
+            for c1 in 0..nc {
+                for a in 0..d {
+                    for c2 in 0..nc {
+                        for b in 0..d {
+                            jac[(c1 * q + off + a, c2 * q + off + b)] = je[(c1 * d + a, c2 * d + b)];
+                        }
+                    }
+                }
+            }
+        }
+        Ok(jac)
+    }
+
     /// The AFT state of element `e` after the last evaluation (time samples of u, v, g, slip).
     pub fn element_aft(&self, e: usize) -> &ElementAft {
         &self.afts[e]

@@ -1,14 +1,18 @@
 //! Harmonic balance (paper Section 4.1-4.2).
+pub mod bifurcation;
 pub mod condensed;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
 pub mod receptance;
+pub mod stability;
 pub mod sweep;
 
+pub use bifurcation::{bifurcations, stability_at, Bifurcation, BifurcationKind, BranchStabilityError};
 pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
 pub use receptance::Receptance;
+pub use stability::{Hill, HillSettings, Stability, StabilityError};
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};

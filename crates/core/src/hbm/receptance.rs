@@ -23,7 +23,7 @@
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
-use faer::{c64, Accum, Mat, Par};
+use faer::{c64, Accum, Mat, MatRef, Par};
 
 use crate::model::{Damping, LinearModel, ModelError, Modes};
 
@@ -175,6 +175,26 @@ impl Receptance {
 }
 
 impl ModalReceptance {
+    /// Natural circular frequencies ω_r of the modes (rad/s, increasing).
+    pub fn natural_frequencies(&self) -> &[f64] {
+        &self.omega_r
+    }
+
+    /// Modal damping coefficients c_r (modal equation `q̈ + c_r q̇ + ω_r² q`).
+    pub fn damping_coefficients(&self) -> &[f64] {
+        &self.c_r
+    }
+
+    /// `A = Vᵀ Φ` (q × m): each mode seen from the nonlinear directions.
+    pub fn participation(&self) -> MatRef<'_, f64> {
+        self.a.as_ref()
+    }
+
+    /// The mass-normalised modes of the linear model.
+    pub fn modes(&self) -> &Modes {
+        &self.modes
+    }
+
     fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
         let q = self.a.nrows();
         let m = self.omega_r.len();

@@ -1,0 +1,147 @@
+//! Stability along a forced-response branch and its bifurcations: where a Floquet exponent
+//! ([`super::stability`]) crosses the imaginary axis between two accepted points.
+//!
+//! The kind follows from the exponent that crosses and from the branch itself:
+//! - a real exponent where the branch turns back in Ω: a **fold** (limit point; the response
+//!   jumps there in a sweep);
+//! - a real exponent where the branch goes on in the same direction: a **branch point**
+//!   (another branch of periodic solutions crosses this one);
+//! - an exponent with imaginary part ±Ω/2 (a multiplier through −1): a **period doubling**;
+//! - a complex pair otherwise: a **Neimark-Sacker** bifurcation (the response becomes
+//!   quasi-periodic).
+//!
+//! Each is located between its two points by [`zero_along`] on the leading exponent's real
+//! part, along the branch (through a fold as well as along an arc).
+
+use faer::c64;
+
+use super::condensed::{CondensedHbm, HbmError};
+use super::stability::{Hill, Stability, StabilityError};
+use super::sweep::FrequencySweep;
+use crate::continuation::{zero_along, Point, ProblemError};
+
+/// The kinds of bifurcation a forced response shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BifurcationKind {
+    Fold,
+    BranchPoint,
+    PeriodDoubling,
+    NeimarkSacker,
+}
+
+impl BifurcationKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            BifurcationKind::Fold => "fold",
+            BifurcationKind::BranchPoint => "branch point",
+            BifurcationKind::PeriodDoubling => "period doubling",
+            BifurcationKind::NeimarkSacker => "Neimark-Sacker",
+        }
+    }
+}
+
+/// A bifurcation located on a branch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bifurcation {
+    pub kind: BifurcationKind,
+    /// Where it is: Ω (rad/s) and the balance's unknowns.
+    pub omega: f64,
+    pub x: Vec<f64>,
+    /// The crossing exponent at the located point (real part ~0) and, for a Neimark-Sacker,
+    /// its imaginary part: the frequency of the new, incommensurate motion is that (rad/s).
+    pub exponent: c64,
+    /// Index of the accepted point just before it.
+    pub after_point: usize,
+    /// False when the location failed: then `omega` and `x` are the point after the crossing.
+    pub located: bool,
+}
+
+/// Why stability along a branch could not be computed.
+#[derive(Debug, thiserror::Error)]
+pub enum BranchStabilityError {
+    #[error(transparent)]
+    Hbm(#[from] HbmError),
+    #[error(transparent)]
+    Stability(#[from] StabilityError),
+}
+
+/// Relative tolerance on a Floquet exponent's real part, of Ω: exponents within it of the
+/// imaginary axis count as on it (round-off of the Hill eigenproblem is ~1e-12 Ω).
+pub const EXPONENT_TOLERANCE: f64 = 1e-9;
+
+/// Floquet exponents of the solution at `x`, Ω.
+pub fn stability_at(
+    hbm: &mut CondensedHbm<'_>,
+    hill: &Hill,
+    x: &[f64],
+    omega: f64,
+) -> Result<Stability, BranchStabilityError> {
+    let jacobian = hbm.element_force_jacobian(x, omega)?;
+    Ok(hill.exponents(omega, jacobian.as_ref())?)
+}
+
+/// Is the solution with these exponents stable at Ω?
+pub fn is_stable(stability: &Stability, omega: f64) -> bool {
+    stability.is_stable(EXPONENT_TOLERANCE * omega)
+}
+
+/// The bifurcations between consecutive points of a frequency-sweep branch at `level`, given
+/// each point's stability, each located along the branch to `tolerance` on the chord between
+/// its two points.
+pub fn bifurcations(
+    hbm: &mut CondensedHbm<'_>,
+    hill: &Hill,
+    level: f64,
+    points: &[Point],
+    stabilities: &[Stability],
+    tolerance: f64,
+) -> Vec<Bifurcation> {
+    let mut found = Vec::new();
+    for i in 0..points.len().saturating_sub(1) {
+        let (p0, p1) = (&points[i], &points[i + 1]);
+        let (s0, s1) = (is_stable(&stabilities[i], p0.lambda), is_stable(&stabilities[i + 1], p1.lambda));
+        if s0 == s1 {
+            continue;
+        }
+        let unstable = if s0 { &stabilities[i + 1] } else { &stabilities[i] };
+        let omega = p0.lambda.max(p1.lambda);
+        let im = unstable.leading().im.abs();
+        let kind = if im <= 1e-6 * omega {
+            // The branch turns back in Ω within the segments around the crossing?
+            let direction = |j: usize| points.get(j + 1).map(|b| (b.lambda - points[j].lambda).signum());
+            let here = direction(i);
+            let turned = [i.checked_sub(1).and_then(direction), direction(i + 1)]
+                .iter()
+                .any(|d| matches!((d, here), (Some(d), Some(h)) if *d != h));
+            if turned {
+                BifurcationKind::Fold
+            } else {
+                BifurcationKind::BranchPoint
+            }
+        } else if (im - 0.5 * omega).abs() <= 1e-6 * omega {
+            BifurcationKind::PeriodDoubling
+        } else {
+            BifurcationKind::NeimarkSacker
+        };
+        let located = zero_along(&mut FrequencySweep { hbm, level }, [p0, p1], tolerance, |problem, x, w| {
+            let s = stability_at(problem.hbm, hill, x, w).map_err(|e| ProblemError::new(e.to_string()))?;
+            Ok(s.leading().re)
+        });
+        found.push(match located {
+            Ok(z) => {
+                let exponent =
+                    stability_at(hbm, hill, &z.x, z.lambda).map(|s| s.leading()).unwrap_or(unstable.leading());
+                Bifurcation { kind, omega: z.lambda, x: z.x, exponent, after_point: i, located: true }
+            }
+            Err(_) => Bifurcation {
+                kind,
+                omega: p1.lambda,
+                x: p1.x.clone(),
+                exponent: unstable.leading(),
+                after_point: i,
+                located: false,
+            },
+        });
+    }
+    found
+}

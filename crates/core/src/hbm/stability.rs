@@ -1,0 +1,234 @@
+//! Stability of a periodic solution by Hill's method: its Floquet exponents from the harmonic
+//! balance itself, with no time integration.
+//!
+//! A perturbation `y(t) = e^{st} p(t)` of the periodic motion, `p` T-periodic, obeys the linear
+//! equation with periodic coefficients obtained by linearising the equation of motion about the
+//! solution. Written in the harmonics `P` of `p` (the balance's real cos/sin basis), with `∇` the
+//! time derivative on harmonics (`(c, s)_k ↦ kΩ (s, −c)_k`), it is the quadratic eigenproblem
+//!
+//! ```text
+//! [ s² I + s (2∇ + C) + (∇² + C∇ + Λ + K_nl) ] P = 0
+//! ```
+//!
+//! (Hill 1886; in harmonic-balance form, Lazarus & Thomas, C. R. Mécanique 338, 2010, and
+//! Krack & Gross, *Harmonic Balance for Nonlinear Vibration Problems*, Springer 2019, ch. 5).
+//!
+//! **Why modal form.** The balance is solved in flexibility form (the residual is a
+//! displacement, [`super::condensed`]), where `s` would enter through the receptance at the
+//! complex frequencies `kΩ − is`: a rational, not a polynomial, eigenproblem. In the
+//! coordinates of the mass-normalised modes of the linear model (the same modes the modal
+//! receptance sums), `I`, `C = diag(c_r)` and `Λ = diag(ω_r²)` are diagonal and the joints enter
+//! through the low-rank term `K_nl = Aᵀ J A`, `A = Vᵀ Φ` (q × m) and `J = ∂G/∂x` the elements'
+//! harmonic Jacobian that Newton already uses: the quadratic problem is polynomial, of size
+//! `m(2N+1)`, and its companion form is an ordinary real eigenproblem.
+//!
+//! **Modes kept.** The first `m` modes carry the dynamics; the modes above act quasi-statically
+//! through their residual flexibility `R = Σ_{r>m} a_r a_rᵀ / ω_r²` (a static correction), so the
+//! joints' stiffness seen by the kept modes is `Aᵀ J (I + R J)⁻¹ A`. With every mode kept this is
+//! Hill's method on the whole model; the default keeps the modes that a harmonic of the band can
+//! reach (see [`HillSettings`]).
+//!
+//! **Sorting.** The truncated Hill matrix has `2m(2N+1)` eigenvalues, each physical exponent
+//! repeated (approximately) at `s + ijΩ`. The `2m` with the smallest `|Im s|` are the
+//! physical ones (Lazarus & Thomas' criterion); the solution is stable when all have a
+//! negative real part.
+
+use faer::{c64, Mat, MatRef};
+
+use super::fourier::{cos_index, sin_index};
+use super::receptance::Receptance;
+
+/// How many modes Hill's method keeps dynamic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HillSettings {
+    /// Keep the modes whose natural frequency is below this (rad/s); the others act through
+    /// their residual flexibility.
+    pub max_omega: f64,
+    /// At most this many modes (the eigenproblem costs O((2m(2N+1))³)).
+    pub max_modes: usize,
+}
+
+impl HillSettings {
+    /// The modes a harmonic of the balance can excite in the band up to `omega_max` (rad/s):
+    /// natural frequencies up to `(N + 1) Ω_max`, at most 24.
+    pub fn for_band(harmonics: usize, omega_max: f64) -> Self {
+        HillSettings { max_omega: (harmonics as f64 + 1.0) * omega_max, max_modes: 24 }
+    }
+}
+
+/// Why stability cannot be computed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum StabilityError {
+    #[error(
+        "stability needs damping that is diagonal in the modes (Rayleigh, modal or none): Hill's method is \
+         written in modal form here, and the model has a general damping matrix"
+    )]
+    GeneralDamping,
+    #[error("the Hill eigenproblem ({size} × {size}) did not converge")]
+    Eigen { size: usize },
+    #[error("the joints' Jacobian has size {got}, expected {expected}")]
+    JacobianSize { got: usize, expected: usize },
+}
+
+/// The Floquet exponents of one periodic solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stability {
+    /// The physical exponents (1/s), largest real part first.
+    pub exponents: Vec<c64>,
+}
+
+impl Stability {
+    /// The exponent with the largest real part: it decides stability and, with its imaginary
+    /// part, the kind of a bifurcation when it crosses zero (real: fold or branch point;
+    /// complex pair: Neimark-Sacker).
+    pub fn leading(&self) -> c64 {
+        self.exponents.first().copied().unwrap_or(c64::new(f64::NEG_INFINITY, 0.0))
+    }
+
+    /// Stable when every exponent has a negative real part, up to `tolerance` (1/s).
+    pub fn is_stable(&self, tolerance: f64) -> bool {
+        self.leading().re <= tolerance
+    }
+
+    /// Floquet multipliers `e^{sT}` at fundamental `omega` (rad/s).
+    pub fn multipliers(&self, omega: f64) -> Vec<c64> {
+        let period = 2.0 * std::f64::consts::PI / omega;
+        self.exponents.iter().map(|s| (*s * period).exp()).collect()
+    }
+}
+
+/// Hill's method for the solutions of one condensed balance: the modal data, prepared once.
+#[derive(Clone, Debug)]
+pub struct Hill {
+    omega_r: Vec<f64>,
+    c_r: Vec<f64>,
+    /// `Vᵀ φ_r` of the kept modes (q × m).
+    a: Mat<f64>,
+    /// Residual flexibility of the other modes on the directions (q × q).
+    residual: Mat<f64>,
+}
+
+impl Hill {
+    /// Prepare Hill's method on the modes of `receptance`'s linear model.
+    pub fn new(receptance: &Receptance, settings: HillSettings) -> Result<Self, StabilityError> {
+        let Receptance::Modal(modal) = receptance else { return Err(StabilityError::GeneralDamping) };
+        let (omega_r, c_r, a) = (modal.natural_frequencies(), modal.damping_coefficients(), modal.participation());
+        let q = a.nrows();
+        let kept = omega_r.iter().take_while(|&&w| w <= settings.max_omega).count().clamp(1, settings.max_modes);
+        let kept = kept.min(omega_r.len());
+        let residual = Mat::from_fn(q, q, |i, j| {
+            (kept..omega_r.len()).map(|r| a[(i, r)] * a[(j, r)] / (omega_r[r] * omega_r[r])).sum()
+        });
+        Ok(Hill {
+            omega_r: omega_r[..kept].to_vec(),
+            c_r: c_r[..kept].to_vec(),
+            a: a.subcols(0, kept).to_owned(),
+            residual,
+        })
+    }
+
+    /// Number of modes kept dynamic.
+    pub fn n_modes(&self) -> usize {
+        self.omega_r.len()
+    }
+
+    /// Floquet exponents of the solution at fundamental `omega` (rad/s) whose joints' harmonic
+    /// Jacobian is `jacobian` (`∂G/∂x`, q(2N+1) square, coefficient-major as the balance's
+    /// unknowns: [`super::CondensedHbm::element_force_jacobian`]).
+    pub fn exponents(&self, omega: f64, jacobian: MatRef<'_, f64>) -> Result<Stability, StabilityError> {
+        let q = self.a.nrows();
+        let m = self.n_modes();
+        let nq = jacobian.nrows();
+        if nq % q != 0 || jacobian.ncols() != nq || nq == 0 {
+            return Err(StabilityError::JacobianSize { got: nq, expected: q });
+        }
+        let nc = nq / q;
+        let harmonics = (nc - 1) / 2;
+        // Joints' stiffness on the directions, the modes above the kept ones condensed
+        // statically: J (I + R J)⁻¹ (per coefficient, R acts on each harmonic alike).
+        let mut i_rj = Mat::<f64>::identity(nq, nq);
+        for c in 0..nc {
+            for i in 0..q {
+                for col in 0..nq {
+                    let mut v = 0.0;
+                    for l in 0..q {
+                        v += self.residual[(i, l)] * jacobian[(c * q + l, col)];
+                    }
+                    i_rj[(c * q + i, col)] += v;
+                }
+            }
+        }
+        let effective = {
+            use faer::linalg::solvers::Solve;
+            // (I + R J)⁻¹ then J on the left: J (I + R J)⁻¹ = ((I + R J)⁻ᵀ Jᵀ)ᵀ.
+            let jt = jacobian.transpose().to_owned();
+            let x = i_rj.transpose().to_owned().partial_piv_lu().solve(&jt);
+            x.transpose().to_owned()
+        };
+        // K_nl = Aᵀ J_eff A per coefficient pair (mode-wide, coefficient-major).
+        let size = m * nc;
+        let mut k_nl = Mat::<f64>::zeros(size, size);
+        let mut ja = Mat::<f64>::zeros(nq, size);
+        for c2 in 0..nc {
+            for r in 0..m {
+                for row in 0..nq {
+                    let mut v = 0.0;
+                    for l in 0..q {
+                        v += effective[(row, c2 * q + l)] * self.a[(l, r)];
+                    }
+                    ja[(row, c2 * m + r)] = v;
+                }
+            }
+        }
+        for c1 in 0..nc {
+            for r in 0..m {
+                for col in 0..size {
+                    let mut v = 0.0;
+                    for l in 0..q {
+                        v += self.a[(l, r)] * ja[(c1 * q + l, col)];
+                    }
+                    k_nl[(c1 * m + r, col)] = v;
+                }
+            }
+        }
+        // Companion form of s² P + s Δ₁ P + Δ₀ P = 0: s [P; sP] = [0 I; −Δ₀ −Δ₁] [P; sP].
+        let mut companion = Mat::<f64>::zeros(2 * size, 2 * size);
+        for i in 0..size {
+            companion[(i, size + i)] = 1.0;
+        }
+        for row in 0..size {
+            for col in 0..size {
+                companion[(size + row, col)] = -k_nl[(row, col)];
+            }
+        }
+        for r in 0..m {
+            let (w2, c) = (self.omega_r[r] * self.omega_r[r], self.c_r[r]);
+            // Harmonic 0: Δ₀ = ω_r², Δ₁ = c_r.
+            companion[(size + r, r)] -= w2;
+            companion[(size + r, size + r)] -= c;
+            for k in 1..=harmonics {
+                let kw = k as f64 * omega;
+                let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
+                // ∇ (c, s) = kΩ (s, −c); ∇² = −(kΩ)².
+                // Δ₀ = (ω_r² − (kΩ)²) I + c_r ∇,   Δ₁ = c_r I + 2∇.
+                companion[(size + ic, ic)] -= w2 - kw * kw;
+                companion[(size + is, is)] -= w2 - kw * kw;
+                companion[(size + ic, is)] -= c * kw;
+                companion[(size + is, ic)] += c * kw;
+                companion[(size + ic, size + ic)] -= c;
+                companion[(size + is, size + is)] -= c;
+                companion[(size + ic, size + is)] -= 2.0 * kw;
+                companion[(size + is, size + ic)] += 2.0 * kw;
+            }
+        }
+        let mut all = companion.eigenvalues().map_err(|_| StabilityError::Eigen { size: 2 * size })?;
+        if all.iter().any(|s| !s.re.is_finite() || !s.im.is_finite()) {
+            return Err(StabilityError::Eigen { size: 2 * size });
+        }
+        // The 2m physical exponents: the smallest |Im s| (Lazarus & Thomas 2010).
+        all.sort_by(|a, b| a.im.abs().total_cmp(&b.im.abs()));
+        all.truncate(2 * m);
+        all.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+        Ok(Stability { exponents: all })
+    }
+}
