@@ -9,15 +9,17 @@ use std::path::PathBuf;
 use stickslip_core::continuation::{
     maximise_along, Branch, Observer, Options, Predictor, ProblemError, Rejection, Silent, TerminationReason,
 };
+use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::{
-    sweep_frequency, sweep_level, CondensedHbm, FrequencySweep, HbmSettings as CoreHbmSettings, SweepError,
+    bifurcations, stability_at, sweep_frequency, sweep_level, BranchStabilityError, CondensedHbm, FrequencySweep,
+    HbmSettings as CoreHbmSettings, Hill, HillSettings, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
 
 use crate::output::{
-    harmonics_from_coefficients, ElementRecord, JointSides, LevelResult, OutputRecord, Peak, PointRecord,
-    SnapshotResult,
+    harmonics_from_coefficients, BifurcationRecord, ElementRecord, JointSides, LevelResult, OutputRecord, Peak,
+    PointRecord, PointStability, SnapshotResult,
 };
 use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
@@ -91,13 +93,50 @@ pub fn run_level<O: Observer + ?Sized>(
     )?;
     let selectors = selectors(outputs);
     let mut points = Vec::with_capacity(branch.points.len());
+    let hill = match study.hbm.stability {
+        true => {
+            let omega_max = TWO_PI * study.sweep.start_hz.max(study.sweep.end_hz);
+            let settings = HillSettings::for_band(study.hbm.harmonics, omega_max);
+            Some(Hill::new(hbm.receptance(), settings).map_err(BranchStabilityError::from)?)
+        }
+        false => None,
+    };
+    let mut stabilities = Vec::new();
     for (index, p) in branch.points.iter().enumerate() {
         let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
         // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
         let residual = p.residual_norm / branch.residual_scale;
-        points.push(record(&result, p.iterations, residual, study.output_options.time_data.keeps(index)));
+        let mut point = record(&result, p.iterations, residual, study.output_options.time_data.keeps(index));
+        if let Some(hill) = &hill {
+            let stability = stability_at(&mut hbm, hill, &p.x, p.lambda)?;
+            let leading = stability.leading();
+            point.stability = Some(PointStability {
+                stable: is_stable(&stability, p.lambda),
+                exponent_re: leading.re,
+                exponent_im: leading.im,
+            });
+            stabilities.push(stability);
+        }
+        points.push(point);
     }
     let peaks = locate_peaks(&mut hbm, &branch, level, &selectors, &points);
+    let bifurcations = match &hill {
+        Some(hill) => bifurcations(&mut hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
+            .into_iter()
+            .map(|b| -> Result<BifurcationRecord, SweepError> {
+                let result = evaluate_point(&mut hbm, &b.x, b.omega, level, &selectors)?;
+                Ok(BifurcationRecord {
+                    level_n: level,
+                    kind: b.kind.name().to_string(),
+                    frequency_hz: b.omega / TWO_PI,
+                    amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
+                    exponent_im: b.exponent.im,
+                    located: b.located,
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?,
+        None => Vec::new(),
+    };
     let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
         format!(
             "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
@@ -109,7 +148,7 @@ pub fn run_level<O: Observer + ?Sized>(
         note,
         newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
         evaluations: branch.calls.residuals,
-        result: LevelResult { level_n: level, points, peaks },
+        result: LevelResult { level_n: level, points, peaks, bifurcations },
         termination: branch.termination,
     })
 }
@@ -118,6 +157,10 @@ pub fn run_level<O: Observer + ?Sized>(
 /// below any point density, far above round-off (a peak is flat: the amplitude there is known
 /// to ~1e-16 relative when its position is known to ~1e-8).
 const PEAK_TOLERANCE: f64 = 1e-9;
+
+/// Precision of a located bifurcation on the chord between its two points: the Floquet
+/// exponent is linear in the arclength there, so this is reached in a few solves.
+const BIFURCATION_TOLERANCE: f64 = 1e-10;
 
 /// Per output, the resonance peak of |X₁|/F located along the branch between the neighbours of
 /// its largest sampled point ([`maximise_along`]), so that the peak table does not depend on
@@ -259,7 +302,7 @@ pub fn run_grid(
         .iter()
         .map(|&f| solve_at(study, &mut hbm, &selectors, f, level, false))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(LevelResult { level_n: level, points, peaks: Vec::new() })
+    Ok(LevelResult { level_n: level, points, peaks: Vec::new(), bifurcations: Vec::new() })
 }
 
 fn selectors(outputs: &[OutputSpec]) -> Vec<OutputSelector> {
@@ -306,6 +349,7 @@ pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool
                 })
             })
             .collect(),
+        stability: None,
     }
 }
 

@@ -54,10 +54,19 @@ pub fn log_axis(lo: f64, hi: f64) -> Range<f64> {
     lo / 1.5..hi * 1.5
 }
 
-/// One curve: a label and its points.
+/// One curve: a label and its points, drawn dashed where `unstable` (per point; empty when
+/// every point is stable or stability is not known).
 struct Curve {
     label: String,
     points: Vec<(f64, f64)>,
+    unstable: Vec<bool>,
+}
+
+/// A labelled point drawn on a chart (a bifurcation).
+struct Marker {
+    x: f64,
+    y: f64,
+    label: String,
 }
 
 /// A chart of curves, linear x, linear or log y.
@@ -67,6 +76,7 @@ struct Chart {
     y_label: String,
     log_y: bool,
     curves: Vec<Curve>,
+    markers: Vec<Marker>,
 }
 
 impl Chart {
@@ -158,7 +168,7 @@ impl Chart {
         root.present().map_err(e)
     }
 
-    /// The curves, one colour each, and their legend.
+    /// The curves, one colour each, dashed where unstable, their legend, and the markers.
     fn draw_curves<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
         &self,
         chart: &mut ChartContext<'a, DB, CT>,
@@ -166,10 +176,46 @@ impl Chart {
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         for (i, c) in self.curves.iter().enumerate() {
             let color = Palette99::pick(i).to_rgba();
-            chart
-                .draw_series(LineSeries::new(c.points.iter().copied().filter(keep), color.stroke_width(2)))?
-                .label(c.label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            let style = color.stroke_width(2);
+            let kept: Vec<((f64, f64), bool)> = c
+                .points
+                .iter()
+                .enumerate()
+                .map(|(j, &p)| (p, c.unstable.get(j).copied().unwrap_or(false)))
+                .filter(|(p, _)| keep(p))
+                .collect();
+            // Runs of equal stability, each sharing its first point with the previous run's
+            // last so that the curve stays connected where the style changes.
+            let mut start = 0;
+            let mut labelled = false;
+            while start < kept.len() || !labelled {
+                let unstable = kept.get(start).is_some_and(|k| k.1);
+                let mut end = start + 1;
+                while end < kept.len() && kept[end].1 == unstable {
+                    end += 1;
+                }
+                let run: Vec<(f64, f64)> =
+                    kept[start.saturating_sub(1)..end.min(kept.len())].iter().map(|k| k.0).collect();
+                let series = if unstable {
+                    chart.draw_series(DashedLineSeries::new(run, 8, 6, style))?
+                } else {
+                    chart.draw_series(LineSeries::new(run, style))?
+                };
+                if !labelled {
+                    series
+                        .label(c.label.as_str())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                    labelled = true;
+                }
+                start = end;
+            }
+        }
+        for m in self.markers.iter().filter(|m| keep(&(m.x, m.y))) {
+            chart.draw_series(std::iter::once(
+                EmptyElement::at((m.x, m.y))
+                    + Circle::new((0, 0), 5, BLACK.stroke_width(2))
+                    + Text::new(m.label.clone(), (7, -18), (FONT, 15)),
+            ))?;
         }
         chart
             .configure_series_labels()
@@ -229,9 +275,12 @@ fn element_index(p: &PointRecord, element: &str) -> Result<usize, OutputError> {
     })
 }
 
-/// Displacement FRF |X₁|/F (m/N, log scale) of `output` against frequency (Hz), one curve per level.
+/// Displacement FRF |X₁|/F (m/N, log scale) of `output` against frequency (Hz), one curve per
+/// level; dashed where the response is unstable and the bifurcations marked, when the study
+/// computed stability.
 pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(), OutputError> {
     let mut curves = Vec::with_capacity(levels.len());
+    let mut markers = Vec::new();
     for l in levels {
         let points = match l.points.first() {
             Some(p0) => {
@@ -240,16 +289,46 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
             }
             None => Vec::new(),
         };
-        curves.push(Curve { label: format!("{} N", l.level_n), points });
+        curves.push(Curve {
+            label: format!("{} N", l.level_n),
+            points,
+            unstable: l.points.iter().map(is_unstable).collect(),
+        });
+        for b in &l.bifurcations {
+            if let Some((_, a)) = b.amplitudes.iter().find(|(name, _)| name == output) {
+                markers.push(Marker { x: b.frequency_hz, y: a / l.level_n, label: bifurcation_symbol(&b.kind).into() });
+            }
+        }
     }
+    let any_unstable = curves.iter().any(|c| c.unstable.iter().any(|&u| u));
     Chart {
-        title: format!("FRF of {output} (displacement |X₁|/F, one curve per level)"),
+        title: format!(
+            "FRF of {output} (displacement |X₁|/F, one curve per level{})",
+            if any_unstable { "; dashed: unstable" } else { "" }
+        ),
         x_label: "Frequency (Hz)".into(),
         y_label: "Displacement / force (m/N)".into(),
         log_y: true,
         curves,
+        markers,
     }
     .render(path)
+}
+
+/// Is this point known to be unstable?
+fn is_unstable(p: &PointRecord) -> bool {
+    p.stability.is_some_and(|s| !s.stable)
+}
+
+/// The short mark of a bifurcation kind on plots (its name in full is in bifurcations.csv).
+fn bifurcation_symbol(kind: &str) -> &'static str {
+    match kind {
+        "fold" => "LP",
+        "branch point" => "BP",
+        "period doubling" => "PD",
+        "Neimark-Sacker" => "NS",
+        _ => "?",
+    }
 }
 
 /// One FRF plot per output, `dir/frf_<output>.<png|svg>`; returns the files written.
@@ -275,6 +354,7 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
         .map(|k| Curve {
             label: format!("harmonic {k}"),
             points: level.points.iter().map(|p| (p.frequency_hz, p.outputs[o].harmonics[k].0)).collect(),
+            unstable: level.points.iter().map(is_unstable).collect(),
         })
         .collect();
     Chart {
@@ -283,6 +363,7 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
         y_label: "Amplitude (m)".into(),
         log_y: true,
         curves,
+        markers: Vec::new(),
     }
     .render(path)
 }
@@ -299,7 +380,8 @@ pub fn plot_hysteresis(path: &Path, level_n: f64, point: &PointRecord, element: 
         x_label: "Displacement (m)".into(),
         y_label: "Force (N)".into(),
         log_y: false,
-        curves: vec![Curve { label: element.into(), points }],
+        curves: vec![Curve { label: element.into(), points, unstable: Vec::new() }],
+        markers: Vec::new(),
     }
     .render(path)
 }
@@ -315,7 +397,8 @@ pub fn plot_slider_velocity(path: &Path, level_n: f64, point: &PointRecord, elem
         x_label: "Time (ms)".into(),
         y_label: "Velocity (m/s)".into(),
         log_y: false,
-        curves: vec![Curve { label: element.into(), points }],
+        curves: vec![Curve { label: element.into(), points, unstable: Vec::new() }],
+        markers: Vec::new(),
     }
     .render(path)
 }
@@ -338,9 +421,11 @@ pub fn plot_joint_sides(path: &Path, snapshot: &SnapshotResult, sides: &JointSid
             Curve {
                 label: format!("{} = {} + slip velocity (Eq. 33)", sides.dof_a, sides.dof_b),
                 points: two_periods(&sides.velocity_a),
+                unstable: Vec::new(),
             },
-            Curve { label: sides.dof_b.clone(), points: two_periods(&sides.velocity_b) },
+            Curve { label: sides.dof_b.clone(), points: two_periods(&sides.velocity_b), unstable: Vec::new() },
         ],
+        markers: Vec::new(),
     }
     .render(path)
 }

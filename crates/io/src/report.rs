@@ -604,8 +604,9 @@ mod tests {
                     point(260.0, &[("mass", f64::NAN), ("a<b>&c", 9.75e-6)]),
                 ],
                 peaks: vec![],
+                bifurcations: vec![],
             },
-            LevelResult { level_n: 1000.0, points: vec![], peaks: vec![] },
+            LevelResult { level_n: 1000.0, points: vec![], peaks: vec![], bifurcations: vec![] },
         ];
         ReportData {
             title: "study <1> & \"two\".toml".into(),

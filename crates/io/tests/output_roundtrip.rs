@@ -6,7 +6,7 @@ use stickslip_io::study::PlotFormat;
 
 use stickslip_io::output::{
     frf_columns, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results, write_time_data,
-    ElementRecord, LevelResult, OutputRecord, PointRecord,
+    ElementRecord, LevelResult, OutputRecord, PointRecord, PointStability,
 };
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -48,6 +48,11 @@ fn point(f: f64, seed: usize, n_t: usize) -> PointRecord {
             loop_force: series(seed + 3),
             slider_velocity: series(seed + 4),
         }],
+        stability: Some(PointStability {
+            stable: seed % 2 == 0,
+            exponent_re: value(seed + 5),
+            exponent_im: value(seed + 6),
+        }),
     }
 }
 
@@ -57,11 +62,13 @@ fn levels(n_t: usize) -> Vec<LevelResult> {
             level_n: 100.0,
             points: (0..5).map(|i| point(150.0 + i as f64 * 0.1, i, n_t)).collect(),
             peaks: vec![],
+            bifurcations: vec![],
         },
         LevelResult {
             level_n: 1000.0,
             points: (0..3).map(|i| point(350.0 - i as f64 / 3.0, 40 + i, 0)).collect(),
             peaks: vec![],
+            bifurcations: vec![],
         },
     ]
 }

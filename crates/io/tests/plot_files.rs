@@ -51,10 +51,11 @@ fn levels() -> Vec<LevelResult> {
                             loop_force,
                             slider_velocity,
                         }],
+                        stability: None,
                     }
                 })
                 .collect();
-            LevelResult { level_n, points, peaks: vec![] }
+            LevelResult { level_n, points, peaks: vec![], bifurcations: vec![] }
         })
         .collect()
 }

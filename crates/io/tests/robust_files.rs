@@ -70,9 +70,14 @@ fn writers_refuse_non_finite_values_naming_the_quantity_and_where() {
             vel: vec![0.0, 1.0],
         }],
         elements: vec![],
+        stability: None,
     };
-    let levels =
-        vec![LevelResult { level_n: 10.0, points: vec![point(5.0, 1e-6), point(6.0, f64::NAN)], peaks: vec![] }];
+    let levels = vec![LevelResult {
+        level_n: 10.0,
+        points: vec![point(5.0, 1e-6), point(6.0, f64::NAN)],
+        peaks: vec![],
+        bifurcations: vec![],
+    }];
     for (name, result) in [
         ("frf.csv", write_frf_csv(&dir.join("frf.csv"), &levels)),
         ("frf.npz", write_frf_npz(&dir.join("frf.npz"), &levels)),

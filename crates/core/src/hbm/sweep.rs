@@ -17,6 +17,8 @@ pub enum SweepError {
     Hbm(#[from] HbmError),
     #[error(transparent)]
     Continuation(#[from] ContinuationError),
+    #[error(transparent)]
+    Stability(#[from] super::bifurcation::BranchStabilityError),
 }
 
 /// `R(x; Ω) = 0` at a fixed level, λ = Ω (rad/s).

@@ -20,6 +20,9 @@ pub fn frf_columns(template: &PointRecord) -> Vec<String> {
     for e in &template.elements {
         cols.extend([format!("{}_energy_J", e.name), format!("{}_stick_fraction", e.name)]);
     }
+    if template.stability.is_some() {
+        cols.extend(["stable", "floquet_re_per_s", "floquet_im_rad_per_s"].map(String::from));
+    }
     cols
 }
 
@@ -35,6 +38,9 @@ pub fn frf_row(level_n: f64, p: &PointRecord) -> Vec<f64> {
     for e in &p.elements {
         row.extend([e.energy_j, e.stick_fraction]);
     }
+    if let Some(s) = &p.stability {
+        row.extend([f64::from(u8::from(s.stable)), s.exponent_re, s.exponent_im]);
+    }
     row
 }
 
@@ -46,6 +52,7 @@ pub(crate) fn template(levels: &[LevelResult]) -> Result<Option<&PointRecord>, O
         (
             p.outputs.iter().map(|o| (o.name.clone(), o.harmonics.len())).collect::<Vec<_>>(),
             p.elements.iter().map(|e| e.name.clone()).collect::<Vec<_>>(),
+            p.stability.is_some(),
         )
     };
     let expected = shape(first);
@@ -56,11 +63,13 @@ pub(crate) fn template(levels: &[LevelResult]) -> Result<Option<&PointRecord>, O
                     level_n: l.level_n,
                     frequency_hz: p.frequency_hz,
                     message: format!(
-                        "outputs/harmonics {:?} and elements {:?} differ from the first point's {:?} and {:?}",
+                        "outputs/harmonics {:?}, elements {:?} and stability ({}) differ from the first point's {:?}, {:?} and ({})",
                         shape(p).0,
                         shape(p).1,
+                        shape(p).2,
                         expected.0,
-                        expected.1
+                        expected.1,
+                        expected.2
                     ),
                 });
             }
@@ -255,6 +264,43 @@ pub fn write_peaks_csv(path: &Path, peaks: &[Peak]) -> Result<(), OutputError> {
             p.accel_frf,
             u8::from(p.located)
         );
+    }
+    write_file(path, &text)
+}
+
+/// Write `bifurcations.csv`: per level, each bifurcation of the branch (`level_N,kind,
+/// frequency_Hz,located,floquet_im_rad_per_s`, then `<output>_amp_m`, the first harmonic's
+/// amplitude at each output there). A header alone when none was found.
+pub fn write_bifurcations_csv(path: &Path, levels: &[LevelResult]) -> Result<(), OutputError> {
+    let outputs: Vec<String> = levels
+        .iter()
+        .flat_map(|l| l.points.first())
+        .next()
+        .map(|p| p.outputs.iter().map(|o| o.name.clone()).collect())
+        .unwrap_or_default();
+    let mut text = String::from("level_N,kind,frequency_Hz,located,floquet_im_rad_per_s");
+    for o in &outputs {
+        let _ = write!(text, ",{o}_amp_m");
+    }
+    text.push('\n');
+    for b in levels.iter().flat_map(|l| &l.bifurcations) {
+        let values = [b.frequency_hz, b.exponent_im].into_iter().chain(b.amplitudes.iter().map(|a| a.1));
+        for value in values {
+            if !value.is_finite() {
+                return Err(OutputError::NotFinite {
+                    path: path.to_path_buf(),
+                    quantity: format!("a value of the {}", b.kind),
+                    location: format!("{} N, near {} Hz", b.level_n, b.frequency_hz),
+                    value,
+                });
+            }
+        }
+        let _ =
+            write!(text, "{:e},{},{:e},{},{:e}", b.level_n, b.kind, b.frequency_hz, u8::from(b.located), b.exponent_im);
+        for (_, a) in &b.amplitudes {
+            let _ = write!(text, ",{a:e}");
+        }
+        text.push('\n');
     }
     write_file(path, &text)
 }

@@ -17,7 +17,8 @@ use crate::study::PlotFormat;
 use std::path::Path;
 
 pub use csv::{
-    frf_columns, frf_row, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv, write_time_data,
+    frf_columns, frf_row, write_bifurcations_csv, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv,
+    write_time_data,
 };
 pub use npz::write_frf_npz;
 
@@ -29,6 +30,8 @@ pub struct LevelResult {
     pub points: Vec<PointRecord>,
     /// Per output, the resonance peak located along the branch (empty when not located).
     pub peaks: Vec<Peak>,
+    /// Bifurcations along the branch (empty unless stability is computed).
+    pub bifurcations: Vec<BifurcationRecord>,
 }
 
 /// The largest displacement FRF of one output at one level.
@@ -59,6 +62,36 @@ pub struct PointRecord {
     pub residual: f64,
     pub outputs: Vec<OutputRecord>,
     pub elements: Vec<ElementRecord>,
+    /// Stability by Hill's method, when the study asks for it (`stability = true`).
+    pub stability: Option<PointStability>,
+}
+
+/// Stability of a periodic solution: its leading Floquet exponent (the one with the largest
+/// real part; a perturbation grows or decays as `e^{st}`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointStability {
+    pub stable: bool,
+    /// Real part of the leading exponent (1/s): negative when stable.
+    pub exponent_re: f64,
+    /// Its imaginary part (rad/s): 0 for a real exponent, the frequency of the perturbation's
+    /// oscillation otherwise.
+    pub exponent_im: f64,
+}
+
+/// A bifurcation of the branch of one level (see `stickslip_core::hbm::bifurcation`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BifurcationRecord {
+    /// Force level (N).
+    pub level_n: f64,
+    /// "fold", "branch point", "period doubling" or "Neimark-Sacker".
+    pub kind: String,
+    pub frequency_hz: f64,
+    /// |X₁| at each output there (m), in the outputs' order.
+    pub amplitudes: Vec<(String, f64)>,
+    /// Imaginary part of the crossing exponent (rad/s).
+    pub exponent_im: f64,
+    /// False when it could not be located between its two points (then it is the second).
+    pub located: bool,
 }
 
 /// Response of one output at one point.
@@ -158,6 +191,11 @@ pub fn write_results(
     let peaks = dir.join("peaks.csv");
     write_peaks_csv(&peaks, &crate::report::peaks(levels))?;
     let mut files = vec![csv, npz, peaks];
+    if levels.iter().flat_map(|l| &l.points).any(|p| p.stability.is_some()) {
+        let path = dir.join("bifurcations.csv");
+        write_bifurcations_csv(&path, levels)?;
+        files.push(path);
+    }
     write_time_data(dir, levels)?;
     if let Some(format) = plots {
         files.extend(crate::plot::plot_frfs(dir, levels, format)?);

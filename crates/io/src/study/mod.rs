@@ -240,11 +240,13 @@ pub struct HbmSettings {
     pub tolerance: f64,
     /// Newton iterations per point before the step is cut (default 20).
     pub max_iterations: usize,
+    /// Stability of every point by Hill's method, and the bifurcations (default false).
+    pub stability: bool,
 }
 
 impl Default for HbmSettings {
     fn default() -> Self {
-        HbmSettings { harmonics: 7, samples: 300, tolerance: 1e-8, max_iterations: 20 }
+        HbmSettings { harmonics: 7, samples: 300, tolerance: 1e-8, max_iterations: 20, stability: false }
     }
 }
 

@@ -152,6 +152,7 @@ pub(crate) struct RawHarmonicBalance {
     pub samples: Option<S<i64>>,
     pub tolerance: Option<S<f64>>,
     pub max_iterations: Option<S<i64>>,
+    pub stability: Option<S<bool>>,
 }
 
 #[derive(Deserialize)]

@@ -902,6 +902,9 @@ fn hbm(src: &Source, h: Option<&S<raw::RawHarmonicBalance>>) -> Result<HbmSettin
     if let Some(m) = &r.max_iterations {
         out.max_iterations = count_at_most(src, m, CTX, "max_iterations", 1, MAX_ITERATIONS)?;
     }
+    if let Some(b) = &r.stability {
+        out.stability = *b.get_ref();
+    }
     Ok(out)
 }
 
