@@ -424,6 +424,8 @@ pub fn report_data(
             })
             .collect(),
         peaks: peaks(&levels),
+        stability: study.hbm.stability,
+        bifurcations: levels.iter().flat_map(|l| l.bifurcations.iter().cloned()).collect(),
         files: files.to_vec(),
         timings,
     }

@@ -23,7 +23,7 @@ use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine as _;
 
 use crate::output::LevelResult;
-pub use crate::output::Peak;
+pub use crate::output::{BifurcationRecord, Peak};
 
 /// The file name of the report in a run's output directory.
 pub const REPORT_FILE: &str = "report.html";
@@ -41,6 +41,9 @@ pub struct ReportData {
     pub levels: Vec<LevelSummary>,
     /// Largest FRF amplitude per level and output (see [`peaks`]).
     pub peaks: Vec<Peak>,
+    /// Was the stability of every point computed? Then the bifurcations found, all levels.
+    pub stability: bool,
+    pub bifurcations: Vec<BifurcationRecord>,
     /// Files written by the run; the PNG and SVG ones are embedded, the others listed.
     pub files: Vec<PathBuf>,
     /// `(stage, seconds)`, in the order shown; empty when not measured.
@@ -351,6 +354,9 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
     let has = |k: &[Kind]| figures.iter().any(|f| k.contains(&f.kind));
     h.push_str("<nav>");
     let mut nav = vec![("model", "Model"), ("sweep", "Sweep"), ("frf", "FRFs"), ("peaks", "Peaks")];
+    if data.stability {
+        nav.push(("bifurcations", "Stability"));
+    }
     if has(&[Kind::Harmonics]) {
         nav.push(("harmonics", "Harmonics"));
     }
@@ -375,6 +381,9 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
     h.push_str("</section>\n");
 
     peak_section(&mut h, data);
+    if data.stability {
+        bifurcation_section(&mut h, data);
+    }
 
     let level_name = |i: Option<usize>| match i.and_then(|i| data.levels.get(i)) {
         Some(l) => format!("{} N", number(l.level_n)),
@@ -529,6 +538,34 @@ fn peak_section(h: &mut String, data: &ReportData) {
     h.push_str("</table>\n</section>\n");
 }
 
+fn bifurcation_section(h: &mut String, data: &ReportData) {
+    h.push_str("<section id=\"bifurcations\">\n<h2>Stability and bifurcations</h2>\n");
+    h.push_str(
+        "<p>Each point's stability comes from its Floquet exponents by Hill's method (frf.csv: <code>stable</code>, \
+         <code>floquet_re_per_s</code>, <code>floquet_im_rad_per_s</code>); unstable branches are dashed in the FRF \
+         plots. Where an exponent crosses the imaginary axis the branch bifurcates: LP fold, BP branch point, PD period \
+         doubling, NS Neimark-Sacker (<code>bifurcations.csv</code>).</p>\n",
+    );
+    if data.bifurcations.is_empty() {
+        h.push_str("<p>Every point is stable: no bifurcation.</p>\n</section>\n");
+        return;
+    }
+    h.push_str("<table>\n<tr><th>level (N)</th><th>kind</th><th>frequency (Hz)</th><th>|X<sub>1</sub>| at the outputs (m)</th></tr>\n");
+    for b in &data.bifurcations {
+        let amplitudes: Vec<String> = b.amplitudes.iter().map(|(o, a)| format!("{}: {}", escape(o), sig(*a))).collect();
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"num\">{}</td><td>{}{}</td><td class=\"num\">{}</td><td>{}</td></tr>",
+            number(b.level_n),
+            escape(&b.kind),
+            if b.located { "" } else { " (not located: the point after it)" },
+            fixed(b.frequency_hz, 4),
+            amplitudes.join(", ")
+        );
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
 fn figure_grid<'a>(
     h: &mut String,
     wide: bool,
@@ -637,6 +674,8 @@ mod tests {
                 LevelSummary { level_n: 1000.0, points: 0, complete: false, ending: "no convergence <here>".into() },
             ],
             peaks: peaks(&levels),
+            stability: false,
+            bifurcations: vec![],
             files: files.iter().map(|f| dir.join(f)).collect(),
             timings: vec![("sweep".into(), 1.23456)],
         }
