@@ -98,9 +98,12 @@ fn frf_csv_reads_back_exactly() {
     assert_eq!(&header[..4], ["level_N", "frequency_Hz", "newton_iterations", "residual_rel"]);
     assert_eq!(&header[4..7], ["mass_disp_frf_m_per_N", "mass_accel_frf_m_s2_per_N", "mass_peak_m"]);
     assert_eq!(&header[7..9], ["mass_h0_amp_m", "mass_h0_phase_rad"]);
-    assert_eq!(header.last().unwrap(), "joint_1_stick_fraction");
-    // 4 + per output 3 + 2 (N+1) with N = 7, + 2 per element.
-    assert_eq!(header.len(), 4 + 2 * (3 + 16) + 2);
+    assert_eq!(
+        &header[header.len() - 4..],
+        ["joint_1_stick_fraction", "stable", "floquet_re_per_s", "floquet_im_rad_per_s"]
+    );
+    // 4 + per output 3 + 2 (N+1) with N = 7, + 2 per element, + 3 for the stability.
+    assert_eq!(header.len(), 4 + 2 * (3 + 16) + 2 + 3);
     assert_eq!(header, frf_columns(&levels[0].points[0]));
     assert_eq!(rows.len(), 8);
     let mut r = 0;
@@ -114,7 +117,12 @@ fn frf_csv_reads_back_exactly() {
             assert_eq!(row[4], p.outputs[0].disp_frf);
             assert_eq!(row[7 + 2 * 5], p.outputs[0].harmonics[5].0);
             assert_eq!(row[7 + 2 * 5 + 1], p.outputs[0].harmonics[5].1);
-            assert_eq!(row[header.len() - 2], p.elements[0].energy_j);
+            assert_eq!(row[header.len() - 5], p.elements[0].energy_j);
+            let stability = p.stability.unwrap();
+            assert_eq!(
+                row[header.len() - 3..],
+                [f64::from(u8::from(stability.stable)), stability.exponent_re, stability.exponent_im]
+            );
             r += 1;
         }
     }
@@ -197,9 +205,12 @@ fn write_results_writes_table_arrays_time_data_and_plots() {
     let dir = scratch_dir("all").join("run");
     let files = write_results(&dir, &levels(64), Some(PlotFormat::Svg)).unwrap();
     let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
-    assert_eq!(names[..5], ["frf.csv", "frf.npz", "peaks.csv", "frf_mass.svg", "frf_slider-P.svg"]);
+    assert_eq!(names[..6], ["frf.csv", "frf.npz", "peaks.csv", "bifurcations.csv", "frf_mass.svg", "frf_slider-P.svg"]);
     // Harmonics of 2 outputs at 2 levels; loop and slider velocity where time data exist.
-    assert_eq!(names.len(), 5 + 2 * 2 + 2);
+    assert_eq!(names.len(), 6 + 2 * 2 + 2);
+    // Stability known, no bifurcation given: the header alone.
+    let bifurcations = std::fs::read_to_string(dir.join("bifurcations.csv")).unwrap();
+    assert_eq!(bifurcations, "level_N,kind,frequency_Hz,located,floquet_im_rad_per_s,mass_amp_m,slider-P_amp_m\n");
     // No located peaks given: the largest sampled point per level and output, marked 0.
     let peaks = std::fs::read_to_string(dir.join("peaks.csv")).unwrap();
     assert_eq!(peaks.lines().count(), 1 + 2 * 2);
