@@ -70,6 +70,13 @@ pub enum BranchStabilityError {
 pub const EXPONENT_TOLERANCE: f64 = 1e-9;
 
 /// Floquet exponents of the solution at `x`, Ω.
+///
+/// With sliders (Jenkins joints), Hill's matrix depends on the exponent itself: a stuck
+/// slider remembers the displacement at its last slip, a delay Δ back, which a perturbation
+/// `e^{st}` weights by `e^{−sΔ}` ([`super::ElementAft::add_memory_delay`]). The exponents of the
+/// periodic Jacobian (s = 0 in the weights) start a fixed-point iteration
+/// `s ← the eigenvalue of Hill(J(s)) nearest s` for the leading ones, which converges fast
+/// (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
 pub fn stability_at(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
@@ -77,8 +84,47 @@ pub fn stability_at(
     omega: f64,
 ) -> Result<Stability, BranchStabilityError> {
     let jacobian = hbm.element_force_jacobian(x, omega)?;
-    Ok(hill.exponents(omega, jacobian.as_ref())?)
+    let mut stability = hill.exponents(omega, jacobian.as_ref())?;
+    if !hbm.has_memory_delay() {
+        return Ok(stability);
+    }
+    let leading: Vec<usize> =
+        (0..stability.exponents.len()).filter(|&i| stability.exponents[i].im >= 0.0).take(REFINED).collect();
+    for i in leading {
+        let start = stability.exponents[i];
+        let mut s = start;
+        for _ in 0..MEMORY_ITERATIONS {
+            let (jac, _) = hbm.element_force_jacobian_delayed(x, omega, s)?;
+            let all = hill.eigenvalues(omega, jac.as_ref())?;
+            let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
+            let change = (next - s).norm();
+            s = next;
+            if change <= 1e-12 * omega {
+                break;
+            }
+        }
+        // Its conjugate (the same perturbation, real) follows.
+        if let Some(j) = (0..stability.exponents.len())
+            .filter(|&j| j != i)
+            .min_by(|&a, &b| {
+                (stability.exponents[a] - start.conj())
+                    .norm()
+                    .total_cmp(&(stability.exponents[b] - start.conj()).norm())
+            })
+            .filter(|&j| start.im > 0.0 && (stability.exponents[j] - start.conj()).norm() <= 1e-9 * omega)
+        {
+            stability.exponents[j] = s.conj();
+        }
+        stability.exponents[i] = s;
+    }
+    stability.exponents.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+    Ok(stability)
 }
+
+/// Exponents refined for the sliders' memory (the leading ones, one per conjugate pair) and the
+/// fixed-point iterations allowed each.
+const REFINED: usize = 3;
+const MEMORY_ITERATIONS: usize = 50;
 
 /// Is the solution with these exponents stable at Ω?
 pub fn is_stable(stability: &Stability, omega: f64) -> bool {

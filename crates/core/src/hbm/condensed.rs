@@ -408,6 +408,45 @@ impl<'m> CondensedHbm<'m> {
         Ok(jac)
     }
 
+    /// `∂G/∂x` for a perturbation `e^{st} p(t)` of the solution at `x`, Ω (complex, same layout
+    /// as [`Self::element_force_jacobian`]): the sliders' memory of their anchor weighted by
+    /// `e^{−sΔ}` ([`ElementAft::add_memory_delay`]). Returns also whether any element has such
+    /// a delay (if not, the matrix is the real `∂G/∂x`, whatever `s`).
+    pub fn element_force_jacobian_delayed(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        s: c64,
+    ) -> Result<(Mat<c64>, bool), HbmError> {
+        let real = self.element_force_jacobian(x, omega)?;
+        let (q, nc) = (self.q, self.plan.n_coeffs());
+        let mut jac = Mat::from_fn(q * nc, q * nc, |i, j| c64::new(real[(i, j)], 0.0));
+        let mut delayed = false;
+        for (e, site) in self.model.elements.iter().enumerate() {
+            let (d, off) = (site.law.n_dirs(), self.offsets[e]);
+            let mut block = Mat::from_fn(d * nc, d * nc, |i, j| c64::new(self.elem_jac[e][(i, j)], 0.0));
+            if self.afts[e].add_memory_delay(&self.plan, omega, s, &mut block) {
+                delayed = true;
+                for c1 in 0..nc {
+                    for a in 0..d {
+                        for c2 in 0..nc {
+                            for b in 0..d {
+                                jac[(c1 * q + off + a, c2 * q + off + b)] = block[(c1 * d + a, c2 * d + b)];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok((jac, delayed))
+    }
+
+    /// Did the last Jacobian include a slider's memory of its anchor, which a perturbation
+    /// `e^{st}` delays ([`Self::element_force_jacobian_delayed`])?
+    pub fn has_memory_delay(&self) -> bool {
+        self.afts.iter().any(|a| a.has_memory_delay())
+    }
+
     /// The AFT state of element `e` after the last evaluation (time samples of u, v, g, slip).
     pub fn element_aft(&self, e: usize) -> &ElementAft {
         &self.afts[e]

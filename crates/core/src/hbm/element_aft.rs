@@ -39,7 +39,7 @@
 //! O(n_t N²).
 
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatMut, Par};
+use faer::{c64, Accum, Mat, MatMut, Par};
 
 use super::fourier::{AftPlan, AftScratch};
 use crate::elements::{Element, Tangent};
@@ -85,6 +85,9 @@ pub struct ElementAft {
     state_after_start: Vec<f64>,
     /// Slider anchor at each sample (closed-form slider Jacobian), `usize::MAX` for none.
     anchor: Vec<usize>,
+    /// `(k, first marched sample)` when the last Jacobian was a slider's closed form: what
+    /// [`Self::add_memory_delay`] needs.
+    slider_jacobian_of: Option<(f64, usize)>,
     /// Fourier sums of the stick weights, cos and sin, harmonics 0..=2N.
     weight_cos: Vec<f64>,
     weight_sin: Vec<f64>,
@@ -126,6 +129,7 @@ impl ElementAft {
             state_period_start: vec![0.0; s],
             state_after_start: vec![0.0; s],
             anchor: vec![usize::MAX; nt],
+            slider_jacobian_of: None,
             weight_cos: vec![0.0; 2 * (nc / 2) + 1],
             weight_sin: vec![0.0; 2 * (nc / 2) + 1],
             tangent: Tangent::new(d, s),
@@ -265,8 +269,10 @@ impl ElementAft {
                 g_coeffs[c * d + a] = self.coeff_buf[c];
             }
         }
+        self.slider_jacobian_of = None;
         if let Some((mut jac, dg_domega)) = jacobian {
             if let Some(k) = slider {
+                self.slider_jacobian_of = Some((k, j0));
                 self.slider_jacobian(plan, k, law.replaced_stiffness(0, 0), j0, jac);
                 dg_domega.iter_mut().for_each(|v| *v = 0.0);
                 return Ok(());
@@ -341,6 +347,52 @@ impl ElementAft {
                 }
             }
         }
+    }
+
+    /// Was the last Jacobian a slider's closed form, whose memory term
+    /// [`Self::add_memory_delay`] weights for a perturbation `e^{st}`?
+    ///
+    /// For a perturbation `e^{st} p(t)` of the periodic motion rather than a periodic one: add
+    /// to the complex Jacobian block `jac` (`nc × nc`, initialised with the real `∂G/∂X`) the
+    /// change of a stuck slider's memory. Stuck at sample j, the slider force depends on the
+    /// displacement at its anchor a(j), a delay `Δ_j` earlier; under `e^{st}` that term is
+    /// weighted by `e^{−sΔ_j}` instead of 1:
+    ///
+    /// ```text
+    /// J(s) = ∂G/∂X + k Σ_{j stuck} (1 − e^{−sΔ_j}) P_j E_a(j)ᵀ
+    /// ```
+    ///
+    /// Exact for sliders (the stick-slip instants fall at velocity reversals, where their
+    /// shift under the perturbation is of second order). False, `jac` unchanged, when the last
+    /// Jacobian was not a slider's closed form (a law whose Jacobian has no delay term, or the
+    /// generic chain rule, for which the periodic Jacobian is kept).
+    pub fn has_memory_delay(&self) -> bool {
+        self.slider_jacobian_of.is_some()
+    }
+
+    /// (See [`Self::has_memory_delay`].)
+    pub fn add_memory_delay(&self, plan: &AftPlan, omega: f64, s: c64, jac: &mut Mat<c64>) -> bool {
+        let Some((k, j0)) = self.slider_jacobian_of else { return false };
+        let (nc, nt) = (self.nc, self.nt);
+        let dt = 2.0 * std::f64::consts::PI / (omega * nt as f64);
+        let p = plan.projection();
+        for i in 0..nt {
+            let j = (j0 + i) % nt;
+            let a = self.anchor[j];
+            if self.slipping[j] || a == usize::MAX {
+                continue;
+            }
+            let delay = ((j + nt - a) % nt) as f64 * dt;
+            let weight = (c64::new(1.0, 0.0) - (-s * delay).exp()) * k;
+            let e_a = plan.basis_at(a);
+            for c in 0..nc {
+                let pc = weight * p[(c, j)];
+                for c2 in 0..nc {
+                    jac[(c, c2)] += pc * e_a[c2];
+                }
+            }
+        }
+        true
     }
 
     fn load_sample(&mut self, j: usize) {

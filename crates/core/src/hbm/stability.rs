@@ -57,7 +57,7 @@ impl HillSettings {
 }
 
 /// Why stability cannot be computed.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum StabilityError {
     #[error(
         "stability needs damping that is diagonal in the modes (Rayleigh, modal or none): Hill's method is \
@@ -136,6 +136,14 @@ impl Hill {
     /// Jacobian is `jacobian` (`∂G/∂x`, q(2N+1) square, coefficient-major as the balance's
     /// unknowns: [`super::CondensedHbm::element_force_jacobian`]).
     pub fn exponents(&self, omega: f64, jacobian: MatRef<'_, f64>) -> Result<Stability, StabilityError> {
+        let complex = Mat::from_fn(jacobian.nrows(), jacobian.ncols(), |i, j| c64::new(jacobian[(i, j)], 0.0));
+        let all = self.eigenvalues(omega, complex.as_ref())?;
+        Ok(Stability { exponents: self.physical(all) })
+    }
+
+    /// Every eigenvalue of Hill's problem with the joints' Jacobian `jacobian` (complex when
+    /// it depends on the exponent: [`super::CondensedHbm::element_force_jacobian_delayed`]).
+    pub fn eigenvalues(&self, omega: f64, jacobian: MatRef<'_, c64>) -> Result<Vec<c64>, StabilityError> {
         let q = self.a.nrows();
         let m = self.n_modes();
         let nq = jacobian.nrows();
@@ -146,13 +154,13 @@ impl Hill {
         let harmonics = (nc - 1) / 2;
         // Joints' stiffness on the directions, the modes above the kept ones condensed
         // statically: J (I + R J)⁻¹ (per coefficient, R acts on each harmonic alike).
-        let mut i_rj = Mat::<f64>::identity(nq, nq);
+        let mut i_rj = Mat::<c64>::identity(nq, nq);
         for c in 0..nc {
             for i in 0..q {
                 for col in 0..nq {
-                    let mut v = 0.0;
+                    let mut v = c64::new(0.0, 0.0);
                     for l in 0..q {
-                        v += self.residual[(i, l)] * jacobian[(c * q + l, col)];
+                        v += jacobian[(c * q + l, col)] * self.residual[(i, l)];
                     }
                     i_rj[(c * q + i, col)] += v;
                 }
@@ -160,19 +168,18 @@ impl Hill {
         }
         let effective = {
             use faer::linalg::solvers::Solve;
-            // (I + R J)⁻¹ then J on the left: J (I + R J)⁻¹ = ((I + R J)⁻ᵀ Jᵀ)ᵀ.
+            // J (I + R J)⁻¹ = ((I + R J)⁻ᵀ Jᵀ)ᵀ.
             let jt = jacobian.transpose().to_owned();
             let x = i_rj.transpose().to_owned().partial_piv_lu().solve(&jt);
             x.transpose().to_owned()
         };
         // K_nl = Aᵀ J_eff A per coefficient pair (mode-wide, coefficient-major).
         let size = m * nc;
-        let mut k_nl = Mat::<f64>::zeros(size, size);
-        let mut ja = Mat::<f64>::zeros(nq, size);
+        let mut ja = Mat::<c64>::zeros(nq, size);
         for c2 in 0..nc {
             for r in 0..m {
                 for row in 0..nq {
-                    let mut v = 0.0;
+                    let mut v = c64::new(0.0, 0.0);
                     for l in 0..q {
                         v += effective[(row, c2 * q + l)] * self.a[(l, r)];
                     }
@@ -180,55 +187,62 @@ impl Hill {
                 }
             }
         }
+        // Companion form of s² P + s Δ₁ P + Δ₀ P = 0: s [P; sP] = [0 I; −Δ₀ −Δ₁] [P; sP].
+        let mut companion = Mat::<c64>::zeros(2 * size, 2 * size);
+        for i in 0..size {
+            companion[(i, size + i)] = c64::new(1.0, 0.0);
+        }
         for c1 in 0..nc {
             for r in 0..m {
                 for col in 0..size {
-                    let mut v = 0.0;
+                    let mut v = c64::new(0.0, 0.0);
                     for l in 0..q {
-                        v += self.a[(l, r)] * ja[(c1 * q + l, col)];
+                        v += ja[(c1 * q + l, col)] * self.a[(l, r)];
                     }
-                    k_nl[(c1 * m + r, col)] = v;
+                    companion[(size + c1 * m + r, col)] = -v;
                 }
             }
         }
-        // Companion form of s² P + s Δ₁ P + Δ₀ P = 0: s [P; sP] = [0 I; −Δ₀ −Δ₁] [P; sP].
-        let mut companion = Mat::<f64>::zeros(2 * size, 2 * size);
-        for i in 0..size {
-            companion[(i, size + i)] = 1.0;
-        }
-        for row in 0..size {
-            for col in 0..size {
-                companion[(size + row, col)] = -k_nl[(row, col)];
-            }
-        }
+        let real = |v: f64| c64::new(v, 0.0);
         for r in 0..m {
             let (w2, c) = (self.omega_r[r] * self.omega_r[r], self.c_r[r]);
             // Harmonic 0: Δ₀ = ω_r², Δ₁ = c_r.
-            companion[(size + r, r)] -= w2;
-            companion[(size + r, size + r)] -= c;
+            companion[(size + r, r)] -= real(w2);
+            companion[(size + r, size + r)] -= real(c);
             for k in 1..=harmonics {
                 let kw = k as f64 * omega;
                 let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
                 // ∇ (c, s) = kΩ (s, −c); ∇² = −(kΩ)².
                 // Δ₀ = (ω_r² − (kΩ)²) I + c_r ∇,   Δ₁ = c_r I + 2∇.
-                companion[(size + ic, ic)] -= w2 - kw * kw;
-                companion[(size + is, is)] -= w2 - kw * kw;
-                companion[(size + ic, is)] -= c * kw;
-                companion[(size + is, ic)] += c * kw;
-                companion[(size + ic, size + ic)] -= c;
-                companion[(size + is, size + is)] -= c;
-                companion[(size + ic, size + is)] -= 2.0 * kw;
-                companion[(size + is, size + ic)] += 2.0 * kw;
+                companion[(size + ic, ic)] -= real(w2 - kw * kw);
+                companion[(size + is, is)] -= real(w2 - kw * kw);
+                companion[(size + ic, is)] -= real(c * kw);
+                companion[(size + is, ic)] += real(c * kw);
+                companion[(size + ic, size + ic)] -= real(c);
+                companion[(size + is, size + is)] -= real(c);
+                companion[(size + ic, size + is)] -= real(2.0 * kw);
+                companion[(size + is, size + ic)] += real(2.0 * kw);
             }
         }
-        let mut all = companion.eigenvalues().map_err(|_| StabilityError::Eigen { size: 2 * size })?;
+        let failed = StabilityError::Eigen { size: 2 * size };
+        // A real Hill matrix (a periodic Jacobian) is solved as such: half the work.
+        let all = if companion.col_iter().all(|col| col.iter().all(|v| v.im == 0.0)) {
+            Mat::from_fn(2 * size, 2 * size, |i, j| companion[(i, j)].re).eigenvalues().map_err(|_| failed.clone())?
+        } else {
+            companion.eigenvalues().map_err(|_| failed.clone())?
+        };
         if all.iter().any(|s| !s.re.is_finite() || !s.im.is_finite()) {
-            return Err(StabilityError::Eigen { size: 2 * size });
+            return Err(failed);
         }
-        // The 2m physical exponents: the smallest |Im s| (Lazarus & Thomas 2010).
+        Ok(all)
+    }
+
+    /// The 2m physical exponents among all the eigenvalues of Hill's problem: the smallest
+    /// |Im s| (Lazarus & Thomas 2010), largest real part first.
+    pub fn physical(&self, mut all: Vec<c64>) -> Vec<c64> {
         all.sort_by(|a, b| a.im.abs().total_cmp(&b.im.abs()));
-        all.truncate(2 * m);
+        all.truncate(2 * self.n_modes());
         all.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
-        Ok(Stability { exponents: all })
+        all
     }
 }
