@@ -49,7 +49,7 @@ fn point(f: f64, seed: usize, n_t: usize) -> PointRecord {
             slider_velocity: series(seed + 4),
         }],
         stability: Some(PointStability {
-            stable: seed % 2 == 0,
+            stable: seed.is_multiple_of(2),
             exponent_re: value(seed + 5),
             exponent_im: value(seed + 6),
         }),
