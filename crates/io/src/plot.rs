@@ -614,7 +614,7 @@ fn draw_comparison<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc("Frequency (Hz)")
-        .y_desc(format!("|FRF| ({})", unit.replace('_', " ")))
+        .y_desc(format!("|FRF| ({})", unit_text(unit)))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .label_style((FONT, 15))
         .draw()
