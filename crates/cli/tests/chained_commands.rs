@@ -137,6 +137,12 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     for r in &records {
         assert!(std::path::Path::new(r).exists(), "timesim wrote no {r:?}");
     }
+    // The steady state as written: --write-periods (4) copies of the converged period of 256
+    // steps, sample for sample, and its plot.
+    let record = columns(std::path::Path::new(&records[2]));
+    assert_eq!(record["time_s"].len(), 4 * 256);
+    assert!((0..3 * 256).all(|j| record["tip_m"][j] == record["tip_m"][j + 256]));
+    assert!(dir.join(format!("timesim/timesim_{level}N_{}Hz.png", list[2])).exists());
     let mut extract = vec![s("extract"), s("--stepped"), s("--reference"), s("force"), s("--out"), path("extract")];
     extract.extend(records);
     ok(&extract);
@@ -202,5 +208,25 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     let value = |name: &str| row[col(name)].parse::<f64>().unwrap();
     assert!((value("measured_frequency_Hz") - peak).abs() <= 0.005 * peak, "{text}");
     assert!(value("amplitude_error_pct").abs() <= 1.0, "{text}");
+
+    // The same folder, one frequency: the other records and plots of the previous timesim
+    // go, the user's file stays.
+    std::fs::write(dir.join("timesim/notes.txt"), "mine").unwrap();
+    ok(&[s("timesim"), s("--frequency"), s(&list[2]), s("--out"), path("timesim"), path("study.toml")]);
+    let mut left: Vec<String> = std::fs::read_dir(dir.join("timesim"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    let middle = format!("timesim_{level}N_{}Hz", list[2]);
+    let mut expected = vec![
+        format!("{middle}.csv"),
+        format!("{middle}.png"),
+        "notes.txt".to_string(),
+        "timesim_files.txt".into(),
+        "timesim_summary.csv".into(),
+    ];
+    expected.sort();
+    assert_eq!(left, expected);
     std::fs::remove_dir_all(&dir).unwrap();
 }
