@@ -180,7 +180,10 @@ fn fixed_node_sets_say_what_is_wrong() {
     let error = |fixed: &str| -> String {
         match Study::parse(&study(fixed), dir.join("s.toml")) {
             Err(e) => e.to_string(),
-            Ok(s) => s.build_model().err().expect("refused").to_string(),
+            Ok(s) => match s.build_model() {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("{fixed}: accepted"),
+            },
         }
     };
     let cases = [
