@@ -171,13 +171,16 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
             assert!((v - disp).abs() <= 1e-3 * disp, "{column} at {f} Hz: {v:e} vs {disp:e}");
         }
     }
-    // Each of the three tip FRFs has its own phase column; none is named twice.
-    let header = std::fs::read_to_string(dir.join("extract/frf.csv")).unwrap();
-    let names: Vec<&str> = header.lines().next().unwrap().split(',').collect();
-    for (i, n) in names.iter().enumerate() {
-        assert!(!names[..i].contains(n), "column {n} twice in {names:?}");
+    // Each of the three tip FRFs and harmonics has its own phase column; no column is named
+    // twice in either table.
+    for (table, phase) in [("frf.csv", "tip_m_per_N_phase_rad"), ("harmonics.csv", "tip_m_s2_h3_phase_rad")] {
+        let text = std::fs::read_to_string(dir.join("extract").join(table)).unwrap();
+        let names: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        for (i, n) in names.iter().enumerate() {
+            assert!(!names[..i].contains(n), "{table}: column {n} twice in {names:?}");
+        }
+        assert!(names.contains(&phase) && !names.iter().any(|n| n.starts_with("frequency_h")), "{names:?}");
     }
-    assert!(names.contains(&"tip_m_per_N_phase_rad") && !names.contains(&"frequency_amp_Hz_per_N"), "{names:?}");
 
     let out = ok(&[
         s("compare"),

@@ -141,14 +141,21 @@ fn blocks_of(r: &TimeRecords, s: &Selected, options: &SyncOptions) -> Result<Vec
 }
 
 /// Columns and rows of a harmonics table: time, frequency, reference amplitude, then amplitude and
-/// phase of harmonics 0..N of each response (h0: amplitude = mean, phase 0, as in `frf.csv`).
+/// phase of harmonics 0..N of each response (h0: amplitude = mean, phase 0, as in `frf.csv`):
+/// `<name>_h<k>_amp_<unit>`, `<name>_h<k>_phase_rad` (`<name>_<unit>_h<k>_phase_rad` when
+/// several responses share the name).
 fn harmonics_table(s: &Selected, blocks: &[(f64, &Block)], n: usize) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut columns =
         vec!["time_s".to_string(), "frequency_Hz".into(), format!("{}_h1_amp_{}", s.reference.name, s.reference.unit)];
     for c in &s.responses {
+        // Channels sharing a name (a `timesim` record's displacement, velocity and acceleration
+        // of one output) each get their own phase columns, named with their unit as in the FRF
+        // table (`records` module).
+        let shared = s.responses.iter().filter(|o| o.name == c.name).count() > 1;
+        let phase_of = if shared { format!("{}_{}", c.name, c.unit) } else { c.name.clone() };
         for k in 0..=n {
             columns.push(format!("{}_h{k}_amp_{}", c.name, c.unit));
-            columns.push(format!("{}_h{k}_phase_rad", c.name));
+            columns.push(format!("{phase_of}_h{k}_phase_rad"));
         }
     }
     let rows = blocks
