@@ -1,6 +1,7 @@
-//! `stickslip compare`: measured against simulated FRFs (paper Section 5.1), per force level an
-//! overlay plot of the amplitudes and a table of the resonance peaks (frequency, amplitude and
-//! their errors), on stdout and as CSV.
+//! `stickslip compare`: measured against simulated FRFs (paper Section 5.1), per force level,
+//! output and quantity an overlay plot of the amplitudes (`compare_level<i>_<out>_<disp|vel|accel>`)
+//! and a table of the resonance peaks (frequency, amplitude and their errors), on stdout and as
+//! `peaks.csv`.
 //!
 //! Measured FRFs: CSV (`[level_N,]frequency_Hz,<name>_amp_<unit>[,<name>_phase_rad]`, as
 //! `stickslip extract` writes them) or UFF 58 (function type 4). A curve in `m_s2_per_N` is

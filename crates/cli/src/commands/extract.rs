@@ -4,6 +4,8 @@
 //! the reference channel. With `--stepped`, each record is one stationary excitation (a stepped-
 //! sine frequency, or one point scanned by the vibrometer): one row per record, and `--frames`
 //! reconstructs one period of every response of every record on the common excitation phase.
+//! The FRFs are plotted per unit, amplitude and phase (`<stem>_amp_<unit>`, `<stem>_phase_<unit>`).
+//! A steady state written by `stickslip timesim` is such a stationary record (several periods).
 
 use std::path::{Path, PathBuf};
 
