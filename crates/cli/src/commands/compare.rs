@@ -135,7 +135,7 @@ pub fn main(args: Args) -> Result<()> {
         PlotFormat::Png => "png",
     };
     let mut rows = Vec::new();
-    // Per (level, output): the measured curves (label, frequency, amplitude) and the simulated one.
+    // Per (level, output, quantity): the measured curves and the simulated one.
     let mut groups: Vec<Group> = Vec::new();
     let mut compared = 0;
     let mut available: Vec<String> = Vec::new();
