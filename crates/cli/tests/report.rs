@@ -85,8 +85,8 @@ fn the_report_of_the_1dof_example_shows_every_figure_in_a_headless_browser() {
         .filter(|n| n.ends_with(".png") || n.ends_with(".svg"))
         .collect();
     figures.sort();
-    // FRF, and per level (4) harmonics, hysteresis loop and slider velocity.
-    assert_eq!(figures.len(), 13, "{figures:?}");
+    // FRF and its phase, and per level (4) harmonics, hysteresis loop and slider velocity.
+    assert_eq!(figures.len(), 14, "{figures:?}");
     assert_eq!(html.matches("<img src=\"data:image/png;base64,").count(), figures.len());
     for f in &figures {
         assert!(html.contains(&format!("<code>{f}</code>")), "{f} not in the report");

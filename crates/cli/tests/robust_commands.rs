@@ -36,7 +36,7 @@ fn compare_with_an_amplitude_of_1e308_finishes() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(start.elapsed() < Duration::from_secs(30), "compare took {:?}", start.elapsed());
-    assert!(dir.join("out/compare_level0_tip.svg").exists());
+    assert!(dir.join("out/compare_level0_tip_disp.svg").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -155,5 +155,106 @@ fn modes_refuses_an_indefinite_or_rectangular_mass() {
     let out = modes(&dir, k, small);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("is 3x3 but") && stderr(&out).contains("is 2x2"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_takes_the_curves_it_is_given_and_says_what_it_passes_over() {
+    let dir = scratch("compare-curves");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Velocity amplitudes v symmetric about 30 Hz: the simulated displacement is v / Ω, and
+    // compare's velocity is Ω times it, whose peak (a parabola through the three highest
+    // samples) is 2e-4 m/s/N at 30 Hz exactly.
+    let f = [10.0, 20.0, 30.0, 40.0, 50.0];
+    let v = [1e-5, 5e-5, 2e-4, 5e-5, 1e-5];
+    let mut sim = String::from("level_N,frequency_Hz,tip_disp_frf_m_per_N,tip_accel_frf_m_s2_per_N\n");
+    let mut meas = String::from(
+        "frequency_Hz,tip_amp_m_s_per_N,tip_m_s_per_N_phase_rad,tip_amp_m_per_N,tip_m_per_N_phase_rad,\
+         contact_restoring_force_amp_N_per_N,contact_restoring_force_phase_rad\n",
+    );
+    for (f, v) in f.iter().zip(v) {
+        let omega = 2.0 * std::f64::consts::PI * f;
+        sim.push_str(&format!("1,{f},{:e},{:e}\n", v / omega, v * omega));
+        meas.push_str(&format!("{f},{v:e},0.1,{:e},-1.5,0.5,0.2\n", v / omega));
+    }
+    std::fs::write(dir.join("sim.csv"), sim).unwrap();
+    std::fs::write(dir.join("frf.csv"), meas).unwrap();
+    let compare = |out: &str, extra: &[&str]| {
+        stickslip()
+            .args(["compare", "--measured"])
+            .arg(dir.join("frf.csv"))
+            .arg("--simulated")
+            .arg(dir.join("sim.csv"))
+            .arg("--out")
+            .arg(dir.join(out))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    // Every curve: the joint's force per newton is passed over, said so.
+    let o = compare("all", &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("curve `contact_restoring_force_amp_N_per_N` skipped"), "{}", stderr(&o));
+    for plot in ["compare_level0_tip_vel.svg", "compare_level0_tip_disp.svg"] {
+        assert!(dir.join("all").join(plot).exists(), "no {plot}");
+    }
+    // Only the velocity, picked by its column.
+    let o = compare("vel", &["--curves", "tip_amp_m_s_per_N"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!dir.join("vel/compare_level0_tip_disp.svg").exists());
+    let peaks = std::fs::read_to_string(dir.join("vel/peaks.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = peaks.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 1, "{peaks}");
+    assert_eq!(rows[0][2], "m_s_per_N");
+    let number = |i: usize| rows[0][i].parse::<f64>().unwrap();
+    // measured and simulated frequency, then amplitudes (columns 5, 9 and 10 of 11).
+    assert!((number(5) - 30.0).abs() <= 1e-9 && (number(4) - 30.0).abs() <= 1e-9, "{peaks}");
+    assert!((number(9) - 2e-4).abs() <= 1e-12 && (number(8) - 2e-4).abs() <= 1e-12, "{peaks}");
+    // Curves that are not there, or that compare cannot compare, are refused by name.
+    let o = compare("none", &["--curves", "nope"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--curves: no measured curve `nope`; the measured files have [\"tip_amp_m_s_per_N\""));
+    let o = compare("force", &["--curves", "contact_restoring_force"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("curve `contact_restoring_force_amp_N_per_N` cannot be compared: use m_s2_per_N"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn extract_leaves_a_frequency_channel_out_of_the_responses() {
+    // A swept record as `timesim --sweep-rate` writes it carries the excitation's frequency
+    // (`frequency_Hz`): once extract took it for a response, an FRF in Hz per newton.
+    let dir = scratch("extract-frequency");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (rate, f, phase) = (1000.0, 50.0, -0.3);
+    let mut csv = String::from("time_s,frequency_Hz,force_N,tip_m\n");
+    for j in 0..2000 {
+        let t = j as f64 / rate;
+        let w = 2.0 * std::f64::consts::PI * f * t;
+        csv.push_str(&format!("{t:e},{f},{:e},{:e}\n", 2.0 * w.cos(), 1e-3 * (w + phase).cos()));
+    }
+    std::fs::write(dir.join("sweep.csv"), csv).unwrap();
+    let o = stickslip()
+        .args(["extract", "--reference", "force", "--cycles-per-block", "10", "--no-plots", "--out"])
+        .arg(dir.join("out"))
+        .arg(dir.join("sweep.csv"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = common::columns(&dir.join("out/sweep_frf.csv"));
+    let mut names: Vec<&String> = table.keys().collect();
+    names.sort();
+    assert_eq!(names, ["frequency_Hz", "level_N", "tip_amp_m_per_N", "tip_phase_rad"]);
+    // 1 mm under 2 N: 5e-4 m/N, 0.3 rad behind, in every block: sampled sines fitted over
+    // whole cycles are exact to round-off (1e-15 measured; 1e-12 leaves room for the sums over
+    // 200 samples and the reference's phase, not for a wrong normalisation or a block off by a
+    // sample).
+    for (a, p) in table["tip_amp_m_per_N"].iter().zip(&table["tip_phase_rad"]) {
+        assert!((a - 5e-4).abs() <= 1e-12 * 5e-4 && (p - phase).abs() <= 1e-12, "{a:e} m/N, {p} rad");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

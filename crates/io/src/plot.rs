@@ -5,7 +5,12 @@
 //! - [`plot_hysteresis`]: force against displacement of one element over a period;
 //! - [`plot_slider_velocity`]: slider velocity v_P over a period (paper Eq. 33, Fig. 17);
 //! - [`plot_joint_sides`]: velocities of a joint's two sides over two periods of a snapshot
-//!   (the paper's Figs. 22-23: blade top P and envelope contact B).
+//!   (the paper's Figs. 22-23: blade top P and envelope contact B);
+//! - [`plot_frf_phase`]: phase of the first harmonic (degrees) against frequency, beside the
+//!   FRF amplitude plot;
+//! - [`plot_time_records`]: channels of one unit of a time record against time (`timesim`);
+//! - [`plot_frf_set`]: amplitude and phase of extracted FRFs (`extract`);
+//! - [`plot_comparison`]: measured against simulated FRF amplitudes (`compare`).
 //!
 //! SVG keeps text as text and needs no font; PNG rasterises labels with a system font found
 //! through fontconfig (on Debian, the package fonts-dejavu-core provides one).
@@ -17,6 +22,7 @@ use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
 use crate::output::{JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
+use crate::records::{FrfSet, TimeRecords};
 use crate::study::PlotFormat;
 
 const SIZE: (u32, u32) = (1000, 650);
@@ -464,6 +470,273 @@ pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat
         }
     }
     Ok(files)
+}
+
+/// Phase of the first harmonic of `output` against the force, in degrees in (−180, 180],
+/// against frequency (Hz), one curve per level: with `x = A₁ cos(Ωt + φ₁)` under
+/// `F cos Ωt`, φ₁ (0 well below a resonance, −90° at it, −180° above).
+pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Result<(), OutputError> {
+    let mut curves = Vec::with_capacity(levels.len());
+    for l in levels {
+        let points = match l.points.first() {
+            Some(p0) => {
+                let o = output_index(p0, output)?;
+                l.points
+                    .iter()
+                    .filter_map(|p| p.outputs[o].harmonics.get(1).map(|h| (p.frequency_hz, h.1.to_degrees())))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        curves.push(Curve {
+            label: format!("{} N", l.level_n),
+            points,
+            unstable: l.points.iter().map(is_unstable).collect(),
+        });
+    }
+    Chart {
+        title: format!("Phase of {output} (harmonic 1 against the force, one curve per level)"),
+        x_label: "Frequency (Hz)".into(),
+        y_label: "Phase (degrees)".into(),
+        log_y: false,
+        curves,
+        markers: Vec::new(),
+    }
+    .render(path)
+}
+
+/// One phase plot per output, `dir/frf_phase_<output>.<png|svg>`, beside the amplitude plots of
+/// [`plot_frfs`]; returns the files written.
+pub fn plot_frf_phases(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(Vec::new()) };
+    let mut files = Vec::new();
+    for o in &first.outputs {
+        let path = dir.join(format!("frf_phase_{}.{}", o.name, format.extension()));
+        plot_frf_phase(&path, levels, &o.name)?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// Most points drawn per curve of a time record: a swept sine holds millions of samples, which
+/// no plot shows apart; every k-th sample is drawn beyond this.
+const MAX_TIME_POINTS: usize = 20_000;
+
+/// The channels of `records` in `unit` (e.g. `m`) against time (s), one curve each; an error
+/// naming the units there are when none is in `unit`.
+pub fn plot_time_records(path: &Path, title: &str, records: &TimeRecords, unit: &str) -> Result<(), OutputError> {
+    let stride = records.len().div_ceil(MAX_TIME_POINTS).max(1);
+    let dt = 1.0 / records.sample_rate_hz;
+    let curves: Vec<Curve> = records
+        .channels
+        .iter()
+        .filter(|c| c.unit == unit)
+        .map(|c| Curve {
+            label: c.name.clone(),
+            points: c
+                .values
+                .iter()
+                .enumerate()
+                .step_by(stride)
+                .map(|(j, &v)| (records.start_s + j as f64 * dt, v))
+                .collect(),
+            unstable: Vec::new(),
+        })
+        .collect();
+    if curves.is_empty() {
+        let units: Vec<&str> = records.channels.iter().map(|c| c.unit.as_str()).collect();
+        return Err(OutputError::Plot(format!(
+            "{}: no channel in {unit} to plot (the units are {units:?})",
+            records.source
+        )));
+    }
+    Chart {
+        title: title.into(),
+        x_label: "Time (s)".into(),
+        y_label: format!("{} ({})", quantity_of(unit), unit_text(unit)),
+        log_y: false,
+        curves,
+        markers: Vec::new(),
+    }
+    .render(path)
+}
+
+/// What a value in `unit` is, for axis labels.
+fn quantity_of(unit: &str) -> &'static str {
+    match unit {
+        "m" => "Displacement",
+        "m_s" => "Velocity",
+        "m_s2" => "Acceleration",
+        "N" => "Force",
+        _ => "Value",
+    }
+}
+
+/// A unit as read on an axis: `m_s2_per_N` → `m/s² / N`.
+fn unit_text(unit: &str) -> String {
+    let (num, per) = match unit.split_once("_per_") {
+        Some((n, d)) => (n, Some(d)),
+        None => (unit, None),
+    };
+    let num = match num {
+        "m_s" => "m/s",
+        "m_s2" => "m/s²",
+        other => other,
+    };
+    per.map_or_else(|| num.to_string(), |d| format!("{num} / {d}"))
+}
+
+/// The FRFs of `set`, per unit: amplitude (log scale) `<stem>_amp_<unit>` and phase (degrees)
+/// `<stem>_phase_<unit>`, one curve per channel. Returns the files written.
+pub fn plot_frf_set(dir: &Path, stem: &str, set: &FrfSet, format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    let mut units: Vec<&str> = Vec::new();
+    for c in &set.curves {
+        if !units.contains(&c.unit.as_str()) {
+            units.push(&c.unit);
+        }
+    }
+    let level = set.level_n.map_or_else(String::new, |l| format!(" at {l:.4} N"));
+    let mut files = Vec::new();
+    for unit in units {
+        let of_unit: Vec<_> = set.curves.iter().filter(|c| c.unit == unit).collect();
+        let curves = |value: &dyn Fn(num_complex::Complex64) -> f64| -> Vec<Curve> {
+            of_unit
+                .iter()
+                .map(|c| Curve {
+                    label: c.name.clone(),
+                    points: set.frequency_hz.iter().zip(&c.values).map(|(&f, &v)| (f, value(v))).collect(),
+                    unstable: Vec::new(),
+                })
+                .collect()
+        };
+        let path = dir.join(format!("{stem}_amp_{unit}.{}", format.extension()));
+        Chart {
+            title: format!("Extracted FRFs{level} (harmonic 1)"),
+            x_label: "Frequency (Hz)".into(),
+            y_label: format!("|FRF| ({})", unit_text(unit)),
+            log_y: true,
+            curves: curves(&|v| v.norm()),
+            markers: Vec::new(),
+        }
+        .render(&path)?;
+        files.push(path);
+        // Amplitude-only curves have no phase to draw.
+        if of_unit.iter().any(|c| c.has_phase) {
+            let path = dir.join(format!("{stem}_phase_{unit}.{}", format.extension()));
+            Chart {
+                title: format!("Extracted FRFs{level}: phase against the reference"),
+                x_label: "Frequency (Hz)".into(),
+                y_label: "Phase (degrees)".into(),
+                log_y: false,
+                curves: curves(&|v| v.arg().to_degrees()),
+                markers: Vec::new(),
+            }
+            .render(&path)?;
+            files.push(path);
+        }
+    }
+    Ok(files)
+}
+
+/// One measured FRF amplitude curve of [`plot_comparison`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeasuredCurve {
+    /// Where it comes from (a file stem).
+    pub label: String,
+    pub frequency_hz: Vec<f64>,
+    pub amplitude: Vec<f64>,
+}
+
+/// Measured (markers) against simulated (line) FRF amplitudes of one quantity, in `unit`
+/// (e.g. `m_s2_per_N`), on a log axis. The markers are drawn over the line and ringed, so that
+/// measured points on the simulated curve stay visible.
+pub fn plot_comparison(
+    path: &Path,
+    title: &str,
+    unit: &str,
+    simulated: &(Vec<f64>, Vec<f64>),
+    measured: &[MeasuredCurve],
+) -> Result<(), OutputError> {
+    let plot_error = |m: String| OutputError::Plot(format!("{}: {m}", path.display()));
+    match path.extension().and_then(|x| x.to_str()) {
+        Some("svg") => {
+            draw_comparison(SVGBackend::new(path, SIZE).into_drawing_area(), title, unit, simulated, measured)
+                .map_err(plot_error)
+        }
+        Some("png") => {
+            draw_comparison(BitMapBackend::new(path, SIZE).into_drawing_area(), title, unit, simulated, measured)
+                .map_err(plot_error)
+        }
+        _ => Err(plot_error("the plot file name must end in .png or .svg".into())),
+    }
+}
+
+fn draw_comparison<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    unit: &str,
+    simulated: &(Vec<f64>, Vec<f64>),
+    measured: &[MeasuredCurve],
+) -> Result<(), String> {
+    let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+    // Log axis: only positive finite amplitudes are drawn.
+    let points = |f: &[f64], a: &[f64]| -> Vec<(f64, f64)> {
+        f.iter().zip(a).map(|(&x, &y)| (x, y)).filter(|(x, y)| x.is_finite() && y.is_finite() && *y > 0.0).collect()
+    };
+    let sim = points(&simulated.0, &simulated.1);
+    let meas: Vec<(&str, Vec<(f64, f64)>)> =
+        measured.iter().map(|m| (m.label.as_str(), points(&m.frequency_hz, &m.amplitude))).collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for &(x, y) in sim.iter().chain(meas.iter().flat_map(|m| m.1.iter())) {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if !x0.is_finite() {
+        return Err("no positive amplitude to plot".into());
+    }
+    if x1 <= x0 {
+        (x0, x1) = (x0 - 1.0, x1 + 1.0);
+    }
+    // Finite axis ends whatever the data (see `AXIS_LIMIT`).
+    let (x, y) = (linear_axis(x0, x1), log_axis(y0, y1));
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FONT, 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x, y.log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("Frequency (Hz)")
+        .y_desc(format!("|FRF| ({})", unit_text(unit)))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style((FONT, 15))
+        .draw()
+        .map_err(e)?;
+    chart
+        .draw_series(LineSeries::new(sim.iter().copied(), BLACK.stroke_width(2)))
+        .map_err(e)?
+        .label("simulated")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+    for (i, (label, pts)) in meas.iter().enumerate() {
+        let color = Palette99::pick(i + 1).to_rgba();
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(e)?
+            .label(format!("measured {label}"))
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLACK.stroke_width(1)))).map_err(e)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 15))
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)
 }
 
 #[cfg(test)]

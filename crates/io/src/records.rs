@@ -5,7 +5,10 @@
 //!   uniform (the time column is checked);
 //! - measured FRFs: `[level_N,]frequency_Hz,<name>_amp_<unit>[,<name>_phase_rad],...`, e.g.
 //!   `level_N,frequency_Hz,top_amp_m_s2_per_N,top_phase_rad`; rows of several force levels may
-//!   share one file, told apart by `level_N`;
+//!   share one file, told apart by `level_N`. When several curves share a name (the
+//!   displacement, velocity and acceleration FRFs of one output), each phase column carries its
+//!   curve's unit, `<name>_<unit>_phase_rad` (e.g. `tip_m_per_N_phase_rad`), so that no two
+//!   columns are named alike;
 //! - period frames: `frame_<j>.csv` with `point,phase_rad,<quantity>_<unit>`.
 //!
 //! Lines starting with `#` are comments. The tables are purely numeric with a one-line header, so
@@ -492,12 +495,26 @@ pub fn read_frf_csv(path: &Path) -> Result<Vec<FrfSet>, RecordsError> {
         what: format!("no `frequency_Hz` column (found {:?})", table.columns),
     })?;
     let level = table.column("level_N");
+    let amplitude_columns: Vec<(usize, &str, &str)> =
+        table.columns.iter().enumerate().filter_map(|(i, c)| c.split_once("_amp_").map(|(n, u)| (i, n, u))).collect();
     let mut curves: Vec<(String, String, usize, Option<usize>)> = Vec::new();
-    for (i, c) in table.columns.iter().enumerate() {
-        if let Some((name, unit)) = c.split_once("_amp_") {
-            let phase = table.columns.iter().position(|p| *p == format!("{name}_phase_rad"));
-            curves.push((name.to_string(), unit.to_string(), i, phase));
-        }
+    for &(i, name, unit) in &amplitude_columns {
+        let position = |column: &str| table.columns.iter().position(|p| p == column);
+        // The phase of this very curve, or the name's only phase when the name is not shared.
+        let shared = amplitude_columns.iter().filter(|(_, n, _)| *n == name).count() > 1;
+        let phase = match position(&format!("{name}_{unit}_phase_rad")) {
+            Some(p) => Some(p),
+            None if shared && position(&format!("{name}_phase_rad")).is_some() => {
+                return Err(RecordsError::Header {
+                    file,
+                    what: format!(
+                        "`{name}_phase_rad` is ambiguous: several amplitude columns are named `{name}_amp_<unit>`; name each phase `{name}_<unit>_phase_rad` (e.g. `{name}_{unit}_phase_rad`)"
+                    ),
+                });
+            }
+            None => position(&format!("{name}_phase_rad")),
+        };
+        curves.push((name.to_string(), unit.to_string(), i, phase));
     }
     if curves.is_empty() {
         return Err(RecordsError::Header {
@@ -556,8 +573,20 @@ pub fn write_frf_csv(path: &Path, sets: &[FrfSet]) -> Result<(), RecordsError> {
         s.push_str("level_N,");
     }
     s.push_str("frequency_Hz");
-    for c in &first.curves {
-        let _ = write!(s, ",{0}_amp_{1},{0}_phase_rad", c.name, c.unit);
+    for (i, c) in first.curves.iter().enumerate() {
+        let shared = first.curves.iter().filter(|o| o.name == c.name).count() > 1;
+        if first.curves[..i].iter().any(|o| o.name == c.name && o.unit == c.unit) {
+            return Err(RecordsError::Header {
+                file: path.display().to_string(),
+                what: format!("two FRF curves named `{}` in {}: their columns would be named alike", c.name, c.unit),
+            });
+        }
+        // A shared name: each phase column says which curve it belongs to (see the module).
+        if shared {
+            let _ = write!(s, ",{0}_amp_{1},{0}_{1}_phase_rad", c.name, c.unit);
+        } else {
+            let _ = write!(s, ",{0}_amp_{1},{0}_phase_rad", c.name, c.unit);
+        }
     }
     s.push('\n');
     for set in sets {

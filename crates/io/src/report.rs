@@ -208,6 +208,10 @@ fn mime(path: &Path) -> Option<&'static str> {
 
 /// Kind, level and subject from a file stem such as `loop_level2_joint`.
 fn classify(stem: &str) -> (Kind, Option<usize>, String) {
+    // The phase plot beside each FRF plot (`plot::plot_frf_phases`).
+    if let Some(out) = stem.strip_prefix("frf_phase_") {
+        return (Kind::Frf, None, format!("{out} (phase)"));
+    }
     if let Some(out) = stem.strip_prefix("frf_") {
         return (Kind::Frf, None, out.to_string());
     }
@@ -789,5 +793,6 @@ mod tests {
         assert_eq!(classify("loop_level12_a_b"), (Kind::Loop, Some(12), "a_b".into()));
         assert_eq!(classify("harmonics_levelx_m"), (Kind::Other, None, "harmonics_levelx_m".into()));
         assert_eq!(classify("frf_tip"), (Kind::Frf, None, "tip".into()));
+        assert_eq!(classify("frf_phase_tip"), (Kind::Frf, None, "tip (phase)".into()));
     }
 }

@@ -205,12 +205,28 @@ fn write_results_writes_table_arrays_time_data_and_plots() {
     let dir = scratch_dir("all").join("run");
     let files = write_results(&dir, &levels(64), Some(PlotFormat::Svg)).unwrap();
     let names: Vec<_> = files.iter().map(|f| f.file_name().unwrap().to_str().unwrap().to_string()).collect();
-    assert_eq!(names[..6], ["frf.csv", "frf.npz", "peaks.csv", "bifurcations.csv", "frf_mass.svg", "frf_slider-P.svg"]);
+    assert_eq!(
+        names[..8],
+        [
+            "frf.csv",
+            "frf.npz",
+            "peaks.csv",
+            "bifurcations.csv",
+            "frf_mass.svg",
+            "frf_slider-P.svg",
+            "frf_phase_mass.svg",
+            "frf_phase_slider-P.svg"
+        ]
+    );
     // Harmonics of 2 outputs at 2 levels; loop and slider velocity where time data exist.
-    assert_eq!(names.len(), 6 + 2 * 2 + 2);
+    assert_eq!(names.len(), 8 + 2 * 2 + 2);
     // Stability known, no bifurcation given: the header alone.
     let bifurcations = std::fs::read_to_string(dir.join("bifurcations.csv")).unwrap();
     assert_eq!(bifurcations, "level_N,kind,frequency_Hz,located,floquet_im_rad_per_s,mass_amp_m,slider-P_amp_m\n");
+    // The time data files, as `time_data_files` lists them for a run's list of its files.
+    let listed = stickslip_io::output::time_data_files(&dir, &levels(64));
+    assert_eq!(listed.len(), 5);
+    assert!(listed.iter().all(|f| f.starts_with(dir.join("points")) && f.exists()), "{listed:?}");
     // No located peaks given: the largest sampled point per level and output, marked 0.
     let peaks = std::fs::read_to_string(dir.join("peaks.csv")).unwrap();
     assert_eq!(peaks.lines().count(), 1 + 2 * 2);
@@ -231,5 +247,46 @@ fn time_series_of_different_lengths_are_refused() {
     p.elements[0].slider_velocity.pop();
     let msg = stickslip_io::output::write_point_csv(&dir.join("p.csv"), &p).unwrap_err().to_string();
     assert!(msg.ends_with("p.csv: series joint_1_slider_vel_m_s has 15 samples, others 16"), "{msg}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_run_removes_what_its_previous_run_wrote_and_nothing_else() {
+    use stickslip_io::output::{manifest_path, replace_previous_run};
+    let dir = std::env::temp_dir().join(format!("stickslip-io-manifest-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("points")).unwrap();
+    let write = |name: &str| {
+        std::fs::write(dir.join(name), name).unwrap();
+        dir.join(name)
+    };
+    // The user's notes, and another command's file.
+    write("notes.txt");
+    write("compare_level0_tip_disp.svg");
+    // First run: four files, one in a sub-folder.
+    let first: Vec<PathBuf> =
+        ["frf.csv", "frf_tip.svg", "frf_level3.svg", "points/level3_point0.csv"].map(write).to_vec();
+    assert!(replace_previous_run(&dir, "run", &first).unwrap().is_empty(), "nothing listed yet");
+    assert_eq!(
+        std::fs::read_to_string(manifest_path(&dir, "run")).unwrap(),
+        "frf.csv\nfrf_tip.svg\nfrf_level3.svg\npoints/level3_point0.csv\n"
+    );
+    // Second run, fewer levels: two of the old files are not written again.
+    let second: Vec<PathBuf> = ["frf.csv", "frf_tip.svg"].map(write).to_vec();
+    let mut removed = replace_previous_run(&dir, "run", &second).unwrap();
+    removed.sort();
+    assert_eq!(removed, [dir.join("frf_level3.svg"), dir.join("points/level3_point0.csv")]);
+    assert!(!dir.join("points").exists(), "the emptied sub-folder goes too");
+    for kept in ["notes.txt", "compare_level0_tip_disp.svg", "frf.csv", "frf_tip.svg"] {
+        assert!(dir.join(kept).exists(), "{kept} was removed");
+    }
+    // A list edited to point outside the folder removes nothing there.
+    let outside = dir.with_extension("outside");
+    std::fs::write(&outside, "x").unwrap();
+    let escaped = format!("../{}\n/etc/hostname\n", outside.file_name().unwrap().to_string_lossy());
+    std::fs::write(manifest_path(&dir, "run"), escaped).unwrap();
+    assert!(replace_previous_run(&dir, "run", &second).unwrap().is_empty());
+    assert!(outside.exists());
+    std::fs::remove_file(&outside).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
 }

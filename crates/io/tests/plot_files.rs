@@ -3,11 +3,14 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
+use num_complex::Complex64;
 use stickslip_core::elements::{Element, Jenkins};
 use stickslip_io::output::{ElementRecord, LevelResult, OutputRecord, PointRecord};
 use stickslip_io::plot::{
-    plot_frf, plot_frfs, plot_harmonics, plot_hysteresis, plot_level_details, plot_slider_velocity,
+    plot_comparison, plot_frf, plot_frf_phases, plot_frf_set, plot_frfs, plot_harmonics, plot_hysteresis,
+    plot_level_details, plot_slider_velocity, plot_time_records, MeasuredCurve,
 };
+use stickslip_io::records::{Channel, FrfCurve, FrfSet, TimeRecords};
 use stickslip_io::study::PlotFormat;
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -170,5 +173,88 @@ fn round_off_harmonics_do_not_stretch_the_log_axis() {
     // decades 1e-2x. Labels are written on their own line.
     assert!(text.contains("\n1e-4\n"), "expected labels missing");
     assert!(!text.contains("\n1e-2"), "the axis reaches the round-off");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn phase_plots_stand_beside_the_amplitude_plots() {
+    let dir = scratch_dir("plot-phase");
+    let files = plot_frf_phases(&dir, &levels(), PlotFormat::Svg).unwrap();
+    assert_eq!(files, [dir.join("frf_phase_mass.svg")]);
+    let text = svg(&files[0]);
+    for label in ["Phase of mass", "Phase (degrees)", "100 N", "10000 N"] {
+        assert!(text.contains(label), "missing {label:?}");
+    }
+    assert_eq!(text.matches("stroke-width=\"2\"").count(), 3 + 3, "3 curves and 3 legend marks");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn extracted_frfs_are_plotted_per_unit_and_time_records_per_quantity() {
+    let dir = scratch_dir("plot-extract");
+    let f: Vec<f64> = (0..20).map(|i| 100.0 + i as f64).collect();
+    let curve = |name: &str, unit: &str, has_phase: bool| FrfCurve {
+        name: name.into(),
+        unit: unit.into(),
+        values: f.iter().map(|x| Complex64::from_polar(1e-5 * x, -0.01 * x)).collect(),
+        has_phase,
+    };
+    let set = FrfSet {
+        source: "memory".into(),
+        level_n: Some(2.0),
+        frequency_hz: f.clone(),
+        curves: vec![curve("tip", "m_per_N", true), curve("mid", "m_per_N", true), curve("tip", "m_s2_per_N", false)],
+    };
+    let files = plot_frf_set(&dir, "frf", &set, PlotFormat::Svg).unwrap();
+    // An amplitude plot per unit; a phase plot where there is a phase (not for the
+    // amplitude-only acceleration).
+    let names: Vec<_> = files.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(names, ["frf_amp_m_per_N.svg", "frf_phase_m_per_N.svg", "frf_amp_m_s2_per_N.svg"]);
+    let text = svg(&files[0]);
+    assert!(text.contains("m / N") && text.contains("at 2.0000 N"), "axis in m / N, the level in the title");
+    assert_eq!(svg(&files[1]).matches("stroke-width=\"2\"").count(), 2 + 2, "tip and mid, and their legend marks");
+
+    let records = TimeRecords {
+        source: "memory".into(),
+        start_s: 0.0,
+        sample_rate_hz: 1000.0,
+        channels: vec![
+            Channel {
+                name: "force".into(),
+                unit: "N".into(),
+                values: (0..100).map(|j| (0.1 * j as f64).cos()).collect(),
+            },
+            Channel {
+                name: "tip".into(),
+                unit: "m".into(),
+                values: (0..100).map(|j| 1e-5 * (0.1 * j as f64).sin()).collect(),
+            },
+        ],
+    };
+    plot_time_records(&dir.join("t.svg"), "steady state", &records, "m").unwrap();
+    let text = svg(&dir.join("t.svg"));
+    assert!(text.contains("Displacement (m)") && text.contains("Time (s)"));
+    assert_eq!(text.matches("stroke-width=\"2\"").count(), 1 + 1, "the tip only, not the force");
+    let msg = plot_time_records(&dir.join("v.svg"), "t", &records, "m_s").unwrap_err().to_string();
+    assert_eq!(msg, "memory: no channel in m_s to plot (the units are [\"N\", \"m\"])");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn measured_markers_are_drawn_over_the_simulated_line() {
+    let dir = scratch_dir("plot-compare");
+    let f: Vec<f64> = (0..50).map(|i| 100.0 + i as f64).collect();
+    let a: Vec<f64> = f.iter().map(|x| 1.0 / (1.0 + ((x - 125.0) / 3.0).powi(2))).collect();
+    let measured = [MeasuredCurve { label: "test".into(), frequency_hz: f.clone(), amplitude: a.clone() }];
+    let path = dir.join("c.svg");
+    plot_comparison(&path, "tip at 2 N", "m_s2_per_N", &(f, a), &measured).unwrap();
+    let text = svg(&path);
+    // In SVG what comes later is drawn on top: every marker after the simulated line.
+    let line = text.find("<polyline").expect("the simulated line");
+    let first_marker = text.find("<circle").expect("markers");
+    assert!(first_marker > line, "markers drawn under the line");
+    // 50 filled markers, 50 rings, 1 legend marker.
+    assert_eq!(text.matches("<circle").count(), 101);
+    assert!(text.contains("m/s² / N"), "the unit on the axis");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -145,3 +145,48 @@ fn bad_records_say_what_to_change() {
     let e = time_records_from_uff(&ds, "u.uff").unwrap_err();
     assert!(e.to_string().contains("49 samples") && e.to_string().contains("same sample rate and length"), "{e}");
 }
+
+#[test]
+fn curves_sharing_a_name_keep_their_own_phase_columns() {
+    // Displacement, velocity and acceleration FRFs of one output, as `extract` finds them in a
+    // `timesim` record: once three columns were all named `tip_phase_rad`.
+    let curve = |unit: &str, phase: f64| FrfCurve {
+        name: "tip".into(),
+        unit: unit.into(),
+        values: vec![Complex64::from_polar(2.0, phase), Complex64::from_polar(3.0, phase)],
+        has_phase: true,
+    };
+    let mid = FrfCurve { name: "mid".into(), ..curve("m_per_N", 0.25) };
+    let set = FrfSet {
+        source: String::new(),
+        level_n: Some(2.0),
+        frequency_hz: vec![100.0, 101.0],
+        curves: vec![curve("m_per_N", -0.5), curve("m_s_per_N", 1.0), curve("m_s2_per_N", 2.5), mid],
+    };
+    let path = scratch("shared.csv");
+    records::write_frf_csv(&path, std::slice::from_ref(&set)).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.starts_with(
+            "level_N,frequency_Hz,tip_amp_m_per_N,tip_m_per_N_phase_rad,tip_amp_m_s_per_N,tip_m_s_per_N_phase_rad,\
+             tip_amp_m_s2_per_N,tip_m_s2_per_N_phase_rad,mid_amp_m_per_N,mid_phase_rad\n"
+        ),
+        "{text}"
+    );
+    let back = records::read_frf_csv(&path).unwrap();
+    for (a, b) in back[0].curves.iter().zip(&set.curves) {
+        assert_eq!((&a.name, &a.unit, a.has_phase), (&b.name, &b.unit, true));
+        // Each curve its own phase (-0.5, 1.0, 2.5, 0.25 rad), through amplitude and phase.
+        for (x, y) in a.values.iter().zip(&b.values) {
+            assert!((x - y).norm() <= 4e-15 * y.norm(), "{}: {x} vs {y}", a.unit);
+        }
+    }
+    // One phase column for two curves of one name says which it is not.
+    std::fs::write(&path, "frequency_Hz,tip_amp_m_per_N,tip_amp_m_s2_per_N,tip_phase_rad\n100,1,2,0.5\n").unwrap();
+    let msg = records::read_frf_csv(&path).unwrap_err().to_string();
+    assert!(msg.contains("`tip_phase_rad` is ambiguous") && msg.contains("`tip_m_per_N_phase_rad`"), "{msg}");
+    // Two curves of one name and unit would write two columns alike.
+    let twice = FrfSet { curves: vec![curve("m_per_N", 0.0), curve("m_per_N", 1.0)], ..set };
+    let msg = records::write_frf_csv(&path, &[twice]).unwrap_err().to_string();
+    assert!(msg.contains("two FRF curves named `tip` in m_per_N"), "{msg}");
+}

@@ -133,3 +133,77 @@ fn a_gmsh_mesh_needs_a_material() {
     let (model, _, _) = Study::parse(&with, "study.toml").unwrap().build_model().unwrap();
     assert!(model.linear.n_dofs() > 0);
 }
+
+/// The bar of [`bar_inp`] as a Gmsh file (its node sets as physical groups; no material, no
+/// boundary condition: a `.msh` holds neither).
+fn bar_msh(dir: &std::path::Path) -> PathBuf {
+    let mesh = stickslip_fe::mesh::inp::parse(&bar_inp(), "bar.inp").unwrap();
+    let path = dir.join("bar.msh");
+    stickslip_fe::mesh::gmsh_writer::write(&mesh, &path).unwrap();
+    path
+}
+
+#[test]
+fn a_msh_with_fixed_node_sets_is_the_deck_with_its_boundary() {
+    // The deck fixes BASE (1-3) by *BOUNDARY and gives steel; the same mesh as .msh gets both
+    // from the study. Same nodes, elements, material and fixed DOFs: the same M and K, so the
+    // same modes to the eigensolver's round-off.
+    let dir = scratch_dir("msh-fixed");
+    std::fs::write(dir.join("bar.inp"), bar_inp()).unwrap();
+    bar_msh(&dir);
+    std::fs::write(dir.join("inp.toml"), format!("[model]\nmesh = \"bar.inp\"\n{REST}")).unwrap();
+    let material = "material = { young = 210e9, poisson = 0.3, density = 7800.0 }";
+    let msh = format!("[model]\nmesh = \"bar.msh\"\n{material}\nfixed = {{ BASE = [1, 2, 3] }}\n{REST}");
+    std::fs::write(dir.join("msh.toml"), &msh).unwrap();
+    let (from_inp, _, _) = Study::load(dir.join("inp.toml")).unwrap().build_model().unwrap();
+    let (from_msh, _, _) = Study::load(dir.join("msh.toml")).unwrap().build_model().unwrap();
+    assert_eq!(from_msh.linear.n_dofs(), 48, "16 free nodes x 3 directions");
+    assert!(from_msh.linear.dof_index("1.1").is_err(), "node 1 of BASE is fixed");
+    let (a, b) = (lowest_hz(&from_inp.linear, 4), lowest_hz(&from_msh.linear, 4));
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 1e-9 * x, "{a:?} vs {b:?}");
+    }
+    // Only the x direction fixed: y and z of the 4 base nodes are free, 8 more DOFs.
+    let (x_only, _, _) = Study::parse(&msh.replace("BASE = [1, 2, 3]", "BASE = [1]"), dir.join("x.toml"))
+        .unwrap()
+        .build_model()
+        .unwrap();
+    assert_eq!(x_only.linear.n_dofs(), 56);
+}
+
+#[test]
+fn fixed_node_sets_say_what_is_wrong() {
+    let dir = scratch_dir("msh-fixed-errors");
+    bar_msh(&dir);
+    let material = "material = { young = 210e9, poisson = 0.3, density = 7800.0 }";
+    let study = |fixed: &str| format!("[model]\nmesh = \"bar.msh\"\n{material}\nfixed = {fixed}\n{REST}");
+    let error = |fixed: &str| -> String {
+        match Study::parse(&study(fixed), dir.join("s.toml")) {
+            Err(e) => e.to_string(),
+            Ok(s) => match s.build_model() {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("{fixed}: accepted"),
+            },
+        }
+    };
+    let cases = [
+        ("{ BASE = [7] }", "[model] fixed.BASE: direction 7 is not one of 1..6"),
+        ("{ BASE = [1, 1] }", "[model] fixed.BASE: direction 1 is given twice"),
+        ("{ BASE = [] }", "[model] fixed.BASE: no direction"),
+        ("{}", "[model] fixed: no node set given"),
+        ("{ ROOT = [1] }", "[model] fixed.ROOT: no node set (physical group) `ROOT` in"),
+    ];
+    for (fixed, expected) in cases {
+        let e = error(fixed);
+        assert!(e.contains(expected), "{fixed}: {e}");
+    }
+    // The unknown set's message lists the sets there are.
+    assert!(error("{ ROOT = [1] }").contains("\"BASE\""));
+    // Matrices have no node sets.
+    let on_matrices = "[model]\ndofs = [\"a\"]\nmass = [1.0]\nstiffness = [1.0]\nfixed = { BASE = [1] }\n";
+    let e = Study::parse(&format!("{on_matrices}{}", &REST[REST.find("[excitation]").unwrap()..]), dir.join("m.toml"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("`fixed` goes with a `mesh`"), "{e}");
+}

@@ -1,19 +1,23 @@
-//! `stickslip compare`: measured against simulated FRFs (paper Section 5.1), per force level an
-//! overlay plot of the amplitudes and a table of the resonance peaks (frequency, amplitude and
-//! their errors), on stdout and as CSV.
+//! `stickslip compare`: measured against simulated FRFs (paper Section 5.1), per force level,
+//! output and quantity an overlay plot of the amplitudes (`compare_level<i>_<out>_<disp|vel|accel>`)
+//! and a table of the resonance peaks (frequency, amplitude and their errors), on stdout and as
+//! `peaks.csv`.
 //!
-//! Measured FRFs: CSV (`[level_N,]frequency_Hz,<name>_amp_<unit>[,<name>_phase_rad]`) or UFF 58
-//! (function type 4). A curve in `m_s2_per_N` is compared with the simulated
-//! `<name>_accel_frf_m_s2_per_N`, one in `m_per_N` with `<name>_disp_frf_m_per_N`.
+//! Measured FRFs: CSV (`[level_N,]frequency_Hz,<name>_amp_<unit>[,<name>_phase_rad]`, as
+//! `stickslip extract` writes them) or UFF 58 (function type 4). A curve in `m_s2_per_N` is
+//! compared with the simulated `<name>_accel_frf_m_s2_per_N`, one in `m_per_N` with
+//! `<name>_disp_frf_m_per_N`, one in `m_s_per_N` with the latter times Ω (the first harmonic's
+//! velocity). Curves in other units (a joint's force, for instance) are skipped and said so;
+//! `--curves` picks the curves to compare. Each quantity gets its own plot: a displacement and an
+//! acceleration FRF span different decades and do not share an axis.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use plotters::prelude::*;
 use stickslip_core::signal::peaks::{peaks, Peak};
-use stickslip_io::plot;
-use stickslip_io::records::{self, FrfSet};
+use stickslip_io::plot::{self, MeasuredCurve};
+use stickslip_io::records::{self, FrfCurve, FrfSet};
 use stickslip_io::uff;
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -36,6 +40,10 @@ pub struct Args {
     /// Simulated output to compare with (default: the measured curve's name).
     #[arg(long)]
     pub output: Option<String>,
+    /// Measured curves to compare, comma-separated: a curve's name (`tip`, all its units) or
+    /// its amplitude column (`tip_amp_m_s2_per_N`). Default: every curve in a comparable unit.
+    #[arg(long, value_delimiter = ',')]
+    pub curves: Vec<String>,
     /// Force level in N of measured files without a `level_N` column.
     #[arg(long)]
     pub level: Option<f64>,
@@ -68,15 +76,21 @@ fn load_measured(path: &Path) -> Result<Vec<FrfSet>> {
     }
 }
 
-/// Simulated column of an FRF in `unit`, for output `name`.
-fn simulated_column(name: &str, unit: &str) -> Result<String> {
+/// The simulated quantity an FRF in `unit` is compared with: its short name (in plot file
+/// names), the column of `frf.csv` it is read from, and the power of Ω that turns that column
+/// into the unit (the velocity FRF is Ω times the displacement FRF, for the first harmonic).
+fn simulated_quantity(name: &str, unit: &str) -> Option<(&'static str, String, i32)> {
     match unit {
-        "m_s2_per_N" => Ok(format!("{name}_accel_frf_m_s2_per_N")),
-        "m_per_N" => Ok(format!("{name}_disp_frf_m_per_N")),
-        other => bail!(
-            "measured FRF unit `{other}` cannot be compared: use m_s2_per_N (accelerance) or m_per_N (receptance)"
-        ),
+        "m_per_N" => Some(("disp", format!("{name}_disp_frf_m_per_N"), 0)),
+        "m_s_per_N" => Some(("vel", format!("{name}_disp_frf_m_per_N"), 1)),
+        "m_s2_per_N" => Some(("accel", format!("{name}_accel_frf_m_s2_per_N"), 0)),
+        _ => None,
     }
+}
+
+/// Is `curve` among those asked by `--curves` (all when none is asked)?
+fn is_asked(curve: &FrfCurve, asked: &[String]) -> bool {
+    asked.is_empty() || asked.iter().any(|a| *a == curve.name || *a == format!("{}_amp_{}", curve.name, curve.unit))
 }
 
 /// Curves of one overlay plot.
@@ -85,9 +99,10 @@ struct Group {
     level_n: f64,
     output: String,
     unit: String,
+    /// `disp`, `vel` or `accel`.
+    quantity: &'static str,
     simulated: (Vec<f64>, Vec<f64>),
-    /// (label, frequency, amplitude) of each measured curve.
-    measured: Vec<(String, Vec<f64>, Vec<f64>)>,
+    measured: Vec<MeasuredCurve>,
 }
 
 /// One compared peak.
@@ -120,8 +135,10 @@ pub fn main(args: Args) -> Result<()> {
         PlotFormat::Png => "png",
     };
     let mut rows = Vec::new();
-    // Per (level, output): the measured curves (label, frequency, amplitude) and the simulated one.
+    // Per (level, output, quantity): the measured curves and the simulated one.
     let mut groups: Vec<Group> = Vec::new();
+    let mut compared = 0;
+    let mut available: Vec<String> = Vec::new();
     for path in &args.measured {
         let stem = path.file_stem().map_or_else(|| "measured".into(), |s| s.to_string_lossy().into_owned());
         for set in load_measured(path)? {
@@ -141,20 +158,48 @@ pub fn main(args: Args) -> Result<()> {
             };
             let sim_l = levels[level_index];
             let sim_rows: Vec<usize> = (0..sim_level.len()).filter(|&r| sim_level[r] == sim_l).collect();
-            for curve in &set.curves {
+            available.extend(set.curves.iter().map(|c| format!("{}_amp_{}", c.name, c.unit)));
+            for curve in set.curves.iter().filter(|c| is_asked(c, &args.curves)) {
                 let output = args.output.clone().unwrap_or_else(|| curve.name.clone());
-                let column = simulated_column(&output, &curve.unit)?;
-                let sim_amp = sim.column(&column).ok_or_else(|| {
+                let Some((quantity, column, omega_power)) = simulated_quantity(&output, &curve.unit) else {
+                    if !args.curves.is_empty() {
+                        bail!(
+                            "{}: curve `{}_amp_{}` cannot be compared: use m_s2_per_N (accelerance), m_s_per_N (mobility) or m_per_N (receptance)",
+                            path.display(),
+                            curve.name,
+                            curve.unit
+                        );
+                    }
+                    eprintln!(
+                        "note: {}: curve `{}_amp_{}` skipped (not a displacement, velocity or acceleration per newton)",
+                        path.display(),
+                        curve.name,
+                        curve.unit
+                    );
+                    continue;
+                };
+                let Some(sim_amp) = sim.column(&column) else {
                     let outputs: Vec<&str> =
                         sim.columns.iter().filter_map(|c| c.strip_suffix("_disp_frf_m_per_N")).collect();
-                    anyhow::anyhow!(
-                        "{}: no column `{column}` for measured curve `{}`; simulated outputs are {outputs:?} (use --output)",
+                    let message = format!(
+                        "{}: no column `{column}` for measured curve `{}_amp_{}`; simulated outputs are {outputs:?}",
                         sim_path.display(),
-                        curve.name
-                    )
-                })?;
+                        curve.name,
+                        curve.unit
+                    );
+                    // A curve the user picked must be compared; among all the curves of a file
+                    // (a joint's channels extracted beside the outputs), one without a
+                    // simulated output is passed over.
+                    if !args.curves.is_empty() || args.output.is_some() {
+                        bail!("{message} (use --output)");
+                    }
+                    eprintln!("note: {message}: skipped");
+                    continue;
+                };
+                compared += 1;
                 let sim_f: Vec<f64> = sim_rows.iter().map(|&r| sim_freq[r]).collect();
-                let sim_a: Vec<f64> = sim_rows.iter().map(|&r| sim_amp[r].abs()).collect();
+                let omega = |f: f64| (2.0 * std::f64::consts::PI * f).powi(omega_power);
+                let sim_a: Vec<f64> = sim_rows.iter().map(|&r| sim_amp[r].abs() * omega(sim_freq[r])).collect();
                 let meas_a: Vec<f64> = curve.values.iter().map(|v| v.norm()).collect();
                 let sim_peaks = peaks(&sim_f, &sim_a, args.prominence);
                 for m in peaks(&set.frequency_hz, &meas_a, args.prominence) {
@@ -173,7 +218,8 @@ pub fn main(args: Args) -> Result<()> {
                         simulated: nearest,
                     });
                 }
-                let group = match groups.iter().position(|g| g.level_index == level_index && g.output == output) {
+                let same = |g: &Group| g.level_index == level_index && g.output == output && g.quantity == quantity;
+                let group = match groups.iter().position(same) {
                     Some(g) => g,
                     None => {
                         groups.push(Group {
@@ -181,26 +227,49 @@ pub fn main(args: Args) -> Result<()> {
                             level_n: sim_l,
                             output: output.clone(),
                             unit: curve.unit.clone(),
+                            quantity,
                             simulated: (sim_f, sim_a),
                             measured: Vec::new(),
                         });
                         groups.len() - 1
                     }
                 };
-                groups[group].measured.push((stem.clone(), set.frequency_hz.clone(), meas_a));
+                groups[group].measured.push(MeasuredCurve {
+                    label: stem.clone(),
+                    frequency_hz: set.frequency_hz.clone(),
+                    amplitude: meas_a,
+                });
             }
         }
     }
+    for asked in &args.curves {
+        if !available.iter().any(|a| a == asked || a.split_once("_amp_").is_some_and(|(n, _)| n == asked)) {
+            bail!("--curves: no measured curve `{asked}`; the measured files have {available:?}");
+        }
+    }
+    if compared == 0 {
+        bail!(
+            "no measured curve to compare{}: curves in m_per_N, m_s_per_N or m_s2_per_N are compared",
+            if args.curves.is_empty() { String::new() } else { format!(" among --curves {:?}", args.curves) }
+        );
+    }
+    let mut written = Vec::new();
     for g in &groups {
-        let plot = args.out.join(format!("compare_level{}_{}.{ext}", g.level_index, g.output));
-        overlay(&plot, g).with_context(|| format!("plotting {}", plot.display()))?;
+        let plot = args.out.join(format!("compare_level{}_{}_{}.{ext}", g.level_index, g.output, g.quantity));
+        let title = format!("{} at {} N: measured and simulated", g.output, g.level_n);
+        plot::plot_comparison(&plot, &title, &g.unit, &g.simulated, &g.measured)?;
         println!("wrote {}", plot.display());
+        written.push(plot);
     }
     let (table, csv) = peak_table(&rows);
     print!("{table}");
     let csv_path = args.out.join("peaks.csv");
     std::fs::write(&csv_path, csv).with_context(|| format!("writing {}", csv_path.display()))?;
     println!("wrote {}", csv_path.display());
+    written.push(csv_path);
+    for old in stickslip_io::output::replace_previous_run(&args.out, "compare", &written)? {
+        println!("removed {} (written by the previous compare, not by this one)", old.display());
+    }
     Ok(())
 }
 
@@ -208,7 +277,7 @@ pub fn main(args: Args) -> Result<()> {
 fn peak_table(rows: &[PeakRow]) -> (String, String) {
     let mut text = format!(
         "{:>10} {:<14} {:<16} {:>12} {:>12} {:>9} {:>12} {:>12} {:>9}\n",
-        "level_N", "output", "measured", "f_meas_Hz", "f_sim_Hz", "df_%", "amp_meas", "amp_sim", "damp_%"
+        "level_N", "output", "measured", "f_meas_Hz", "f_sim_Hz", "df_%", "amp_meas", "amp_sim", "amp_err_%"
     );
     let mut csv = String::from(
         "level_N,output,unit,measured_file,measured_frequency_Hz,simulated_frequency_Hz,frequency_error_Hz,frequency_error_pct,measured_amplitude,simulated_amplitude,amplitude_error_pct\n",
@@ -231,75 +300,4 @@ fn peak_table(rows: &[PeakRow]) -> (String, String) {
         );
     }
     (text, csv)
-}
-
-/// Measured (points) and simulated (line) FRF amplitudes on a log axis, SVG or PNG by extension.
-fn overlay(path: &Path, g: &Group) -> Result<()> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("png") => draw(BitMapBackend::new(path, (1000, 650)).into_drawing_area(), g),
-        _ => draw(SVGBackend::new(path, (1000, 650)).into_drawing_area(), g),
-    }
-}
-
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, g: &Group) -> Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |err: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{err}");
-    // Log axis: only positive finite amplitudes are drawn.
-    let points = |f: &[f64], a: &[f64]| -> Vec<(f64, f64)> {
-        f.iter().zip(a).map(|(&x, &y)| (x, y)).filter(|(x, y)| x.is_finite() && y.is_finite() && *y > 0.0).collect()
-    };
-    let sim = points(&g.simulated.0, &g.simulated.1);
-    let meas: Vec<(String, Vec<(f64, f64)>)> = g.measured.iter().map(|(l, f, a)| (l.clone(), points(f, a))).collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for &(x, y) in sim.iter().chain(meas.iter().flat_map(|m| m.1.iter())) {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    if !x0.is_finite() {
-        bail!("no positive amplitude to plot");
-    }
-    if x1 <= x0 {
-        (x0, x1) = (x0 - 1.0, x1 + 1.0);
-    }
-    // Finite axis ends whatever the data (an amplitude of 1e308 once made the log axis end at
-    // infinity, where plotting never finished).
-    let (x, y) = (plot::linear_axis(x0, x1), plot::log_axis(y0, y1));
-    root.fill(&WHITE).map_err(e)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{} at {} N: measured and simulated", g.output, g.level_n), ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(85)
-        .build_cartesian_2d(x, y.log_scale())
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .x_desc("frequency (Hz)")
-        .y_desc(format!("|FRF| ({})", g.unit.replace('_', " ")))
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .draw()
-        .map_err(e)?;
-    for (i, (label, pts)) in meas.iter().enumerate() {
-        let color = Palette99::pick(i + 1).to_rgba();
-        chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 2, color.filled())))
-            .map_err(e)?
-            .label(format!("measured {label}"))
-            .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
-    }
-    chart
-        .draw_series(LineSeries::new(sim.iter().copied(), BLACK.stroke_width(2)))
-        .map_err(e)?
-        .label("simulated")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(e)?;
-    root.present().map_err(e)?;
-    Ok(())
 }

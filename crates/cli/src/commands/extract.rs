@@ -4,6 +4,8 @@
 //! the reference channel. With `--stepped`, each record is one stationary excitation (a stepped-
 //! sine frequency, or one point scanned by the vibrometer): one row per record, and `--frames`
 //! reconstructs one period of every response of every record on the common excitation phase.
+//! The FRFs are plotted per unit, amplitude and phase (`<stem>_amp_<unit>`, `<stem>_phase_<unit>`).
+//! A steady state written by `stickslip timesim` is such a stationary record (several periods).
 
 use std::path::{Path, PathBuf};
 
@@ -21,6 +23,12 @@ pub enum UffEncoding {
     Binary,
 }
 
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum PlotFormat {
+    Svg,
+    Png,
+}
+
 #[derive(clap::Args)]
 pub struct Args {
     /// Time-record files: CSV (`time_s,<name>_<unit>,...`) or UFF 58 (`.uff`, `.unv`).
@@ -35,7 +43,8 @@ pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "extract")]
     pub out: PathBuf,
-    /// Response channels, comma-separated (default: every channel but the reference).
+    /// Response channels, comma-separated (default: every channel but the reference and a
+    /// frequency channel in Hz).
     #[arg(long, value_delimiter = ',')]
     pub channels: Vec<String>,
     /// Each record is one stationary excitation (stepped sine, or one scanned point): fit every
@@ -73,6 +82,12 @@ pub struct Args {
     /// "video"), written to OUT/frames/.
     #[arg(long)]
     pub frames: Option<usize>,
+    /// Plot file format of the FRF plots (amplitude and phase per unit; PNG needs a system font).
+    #[arg(long, value_enum, default_value = "svg")]
+    pub plot_format: PlotFormat,
+    /// Do not plot the FRFs.
+    #[arg(long)]
+    pub no_plots: bool,
     /// Frames of the time integral of the responses (vibrometer velocities → displacements, as
     /// in the paper's Fig. 22); the mean is set to zero.
     #[arg(long, requires = "frames")]
@@ -110,7 +125,9 @@ struct Selected<'a> {
 fn select<'a>(r: &'a TimeRecords, args: &Args) -> Result<Selected<'a>> {
     let reference = r.channel(&args.reference)?;
     let responses = if args.channels.is_empty() {
-        r.channels.iter().filter(|c| !std::ptr::eq(*c, reference)).collect()
+        // A channel in Hz is the excitation's frequency (a swept record written by `timesim`
+        // carries one), not a response to it.
+        r.channels.iter().filter(|c| !std::ptr::eq(*c, reference) && c.unit != "Hz").collect()
     } else {
         args.channels.iter().map(|c| r.channel(c)).collect::<Result<Vec<_>, _>>()?
     };
@@ -126,14 +143,21 @@ fn blocks_of(r: &TimeRecords, s: &Selected, options: &SyncOptions) -> Result<Vec
 }
 
 /// Columns and rows of a harmonics table: time, frequency, reference amplitude, then amplitude and
-/// phase of harmonics 0..N of each response (h0: amplitude = mean, phase 0, as in `frf.csv`).
+/// phase of harmonics 0..N of each response (h0: amplitude = mean, phase 0, as in `frf.csv`):
+/// `<name>_h<k>_amp_<unit>`, `<name>_h<k>_phase_rad` (`<name>_<unit>_h<k>_phase_rad` when
+/// several responses share the name).
 fn harmonics_table(s: &Selected, blocks: &[(f64, &Block)], n: usize) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut columns =
         vec!["time_s".to_string(), "frequency_Hz".into(), format!("{}_h1_amp_{}", s.reference.name, s.reference.unit)];
     for c in &s.responses {
+        // Channels sharing a name (a `timesim` record's displacement, velocity and acceleration
+        // of one output) each get their own phase columns, named with their unit as in the FRF
+        // table (`records` module).
+        let shared = s.responses.iter().filter(|o| o.name == c.name).count() > 1;
+        let phase_of = if shared { format!("{}_{}", c.name, c.unit) } else { c.name.clone() };
         for k in 0..=n {
             columns.push(format!("{}_h{k}_amp_{}", c.name, c.unit));
-            columns.push(format!("{}_h{k}_phase_rad", c.name));
+            columns.push(format!("{phase_of}_h{k}_phase_rad"));
         }
     }
     let rows = blocks
@@ -235,6 +259,13 @@ fn write_frfs(dir: &Path, stem: &str, set: &FrfSet, args: &Args) -> Result<Vec<P
         uff::write(&path, &records::frf_set_to_uff(set), enc)?;
         written.push(path);
     }
+    if !args.no_plots {
+        let format = match args.plot_format {
+            PlotFormat::Svg => stickslip_io::study::PlotFormat::Svg,
+            PlotFormat::Png => stickslip_io::study::PlotFormat::Png,
+        };
+        written.extend(stickslip_io::plot::plot_frf_set(dir, stem, set, format)?);
+    }
     Ok(written)
 }
 
@@ -249,6 +280,7 @@ pub fn main(args: Args) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let loaded: Vec<TimeRecords> = args.records.iter().map(|p| load(p)).collect::<Result<_>>()?;
     let mut written = Vec::new();
+    let mut frame_files = Vec::new();
     if !args.stepped {
         let options = SyncOptions {
             n_harmonics: args.harmonics,
@@ -323,11 +355,16 @@ pub fn main(args: Args) -> Result<()> {
             let files =
                 records::write_frames(&args.out.join("frames"), &point_names, &format!("value_{unit}"), &frames)?;
             println!("{} frames of {} points in {}", files.len(), point_names.len(), args.out.join("frames").display());
+            frame_files = files;
         }
         println!("{} stepped-sine records, {:.3} to {:.3} Hz", sorted.len(), first_f(&sorted), last_f(&sorted));
     }
-    for w in written {
+    for w in &written {
         println!("wrote {}", w.display());
+    }
+    written.extend(frame_files);
+    for old in stickslip_io::output::replace_previous_run(&args.out, "extract", &written)? {
+        println!("removed {} (written by the previous extract, not by this one)", old.display());
     }
     Ok(())
 }

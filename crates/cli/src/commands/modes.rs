@@ -13,13 +13,14 @@ use stickslip_io::matrix::{abaqus, calculix, dmig, model_from_pair, mtx, Labelle
 /// How MODEL is read (by its extension, or by what exists next to it):
 ///
 /// - `deck.inp`: an Abaqus/CalculiX deck, meshed and assembled;
+/// - `mesh.msh`: a Gmsh mesh with `--young`, `--poisson` and `--density` (it has no material);
 /// - `job` or `job.sti` / `job.mas` / `job.dof`: CalculiX's exported matrices;
 /// - `K.mtx --mass M.mtx`: Matrix Market files (first line `%%MatrixMarket`), or Abaqus
 ///   `*MATRIX GENERATE` output (`job_STIF1.mtx --mass job_MASS1.mtx`);
 /// - `model.pch` / `.bdf` / `.dat`: Nastran DMIG matrices (`--dmig KAAX,MAAX` by default).
 #[derive(clap::Args)]
 pub struct ModelArgs {
-    /// Model: a .inp deck, a CalculiX matrix job prefix, a stiffness .mtx (with --mass), or a
+    /// Model: a .inp deck, a Gmsh .msh (with --young, --poisson, --density), a CalculiX matrix job prefix, a stiffness .mtx (with --mass), or a
     /// Nastran punch/bulk file with DMIG matrices.
     pub model: PathBuf,
     /// Mass matrix file for a stiffness given as .mtx (Matrix Market or Abaqus).
@@ -28,6 +29,43 @@ pub struct ModelArgs {
     /// Names of the stiffness and mass DMIG matrices.
     #[arg(long, default_value = "KAAX,MAAX")]
     pub dmig: String,
+    /// Young's modulus (Pa) of every solid of a mesh: required with --poisson and --density for
+    /// a Gmsh .msh, which carries no material; replaces an .inp deck's materials.
+    #[arg(long, requires_all = ["poisson", "density"])]
+    pub young: Option<f64>,
+    /// Poisson's ratio of every solid of a mesh, in (-1, 0.5).
+    #[arg(long, requires_all = ["young", "density"], allow_negative_numbers = true)]
+    pub poisson: Option<f64>,
+    /// Density (kg/m^3) of every solid of a mesh.
+    #[arg(long, requires_all = ["young", "poisson"])]
+    pub density: Option<f64>,
+}
+
+/// The material of `--young`, `--poisson` and `--density`, checked; `None` when not given.
+fn material(args: &ModelArgs) -> anyhow::Result<Option<stickslip_fe::mesh::Material>> {
+    let (Some(young), Some(poisson), Some(density)) = (args.young, args.poisson, args.density) else {
+        return Ok(None);
+    };
+    if !(young.is_finite() && young > 0.0) {
+        bail!("--young: Young's modulus must be a finite value > 0 in Pa, got {young}");
+    }
+    if !(density.is_finite() && density > 0.0) {
+        bail!("--density: the density must be a finite value > 0 in kg/m^3, got {density}");
+    }
+    if !(-1.0 < poisson && poisson < 0.5) {
+        bail!("--poisson: Poisson's ratio must be in (-1, 0.5), got {poisson}");
+    }
+    Ok(Some(stickslip_fe::mesh::Material { young, poisson, density }))
+}
+
+/// Read and assemble a mesh, its solids given `material` when there is one.
+fn assemble_mesh(mut mesh: stickslip_fe::mesh::Mesh, path: &Path, args: &ModelArgs) -> anyhow::Result<Loaded> {
+    if let Some(m) = material(args)? {
+        mesh.assign_material(None, "COMMAND_LINE", m).with_context(|| format!("{}: the material", path.display()))?;
+    }
+    eprintln!("assembling {} ...", path.display());
+    let fe = FeModel::assemble(mesh).with_context(|| format!("assembling {}", path.display()))?;
+    Ok(Loaded { model: fe.model.clone(), fe: Some(fe) })
 }
 
 #[derive(clap::Args)]
@@ -56,17 +94,27 @@ pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
     let path = &args.model;
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let start = Instant::now();
+    if args.young.is_some() && !matches!(ext.as_str(), "inp" | "msh") {
+        bail!(
+            "{}: --young, --poisson and --density give the material of a mesh (.inp or .msh); matrices have theirs",
+            path.display()
+        );
+    }
     let loaded = match ext.as_str() {
         "inp" => {
             let mesh = stickslip_fe::mesh::inp::read(path).with_context(|| format!("reading {}", path.display()))?;
-            eprintln!("assembling {} ...", path.display());
-            let fe = FeModel::assemble(mesh).with_context(|| format!("assembling {}", path.display()))?;
-            Loaded { model: fe.model.clone(), fe: Some(fe) }
+            assemble_mesh(mesh, path, args)?
         }
-        "msh" => bail!(
-            "{}: Gmsh meshes carry no material; write an .inp deck (or a study file with a mesh section) instead",
-            path.display()
-        ),
+        "msh" => {
+            if args.young.is_none() {
+                bail!(
+                    "{}: a Gmsh mesh carries no material: give --young PA --poisson NU --density KG_M3 (e.g. steel: --young 2.1e11 --poisson 0.3 --density 7800)",
+                    path.display()
+                );
+            }
+            let mesh = stickslip_fe::mesh::gmsh::read(path).with_context(|| format!("reading {}", path.display()))?;
+            assemble_mesh(mesh, path, args)?
+        }
         "mtx" => {
             let mass = args.mass.as_ref().with_context(|| {
                 format!("{} is a stiffness matrix: give its mass matrix with --mass FILE", path.display())
@@ -216,15 +264,18 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let csv = dir.join("modes.csv");
         std::fs::write(&csv, table).with_context(|| format!("writing {}", csv.display()))?;
-        write_shapes(dir, &loaded, &sol)?;
+        let shapes = write_shapes(dir, &loaded, &sol)?;
         eprintln!("wrote {} and the mode shapes", csv.display());
+        for old in stickslip_io::output::replace_previous_run(dir, "modes", &[csv, shapes])? {
+            eprintln!("removed {} (written by the previous modes, not by this one)", old.display());
+        }
     }
     Ok(())
 }
 
 /// Mode shapes: `modes.vtk` (one point vector per mode) for a mesh, `shapes.csv` (one row per
-/// DOF) for matrices.
-fn write_shapes(dir: &Path, loaded: &Loaded, sol: &EigenSolution) -> anyhow::Result<()> {
+/// DOF) for matrices. Returns the file written.
+fn write_shapes(dir: &Path, loaded: &Loaded, sol: &EigenSolution) -> anyhow::Result<PathBuf> {
     let shapes = &sol.modes.shapes;
     let freqs = sol.modes.frequencies_hz();
     if let Some(fe) = &loaded.fe {
@@ -241,6 +292,7 @@ fn write_shapes(dir: &Path, loaded: &Loaded, sol: &EigenSolution) -> anyhow::Res
         stickslip_fe::mesh::vtk::write(&mut w, "stickslip modes", &fe.mesh.nodes, &fe.mesh.solids, &fields)
             .and_then(|_| w.flush())
             .with_context(|| format!("writing {}", path.display()))?;
+        Ok(path)
     } else {
         let path = dir.join("shapes.csv");
         let mut w = std::io::BufWriter::new(
@@ -253,6 +305,6 @@ fn write_shapes(dir: &Path, loaded: &Loaded, sol: &EigenSolution) -> anyhow::Res
             writeln!(w, "{},{}", d.name, row.join(","))?;
         }
         w.flush()?;
+        Ok(path)
     }
-    Ok(())
 }

@@ -158,10 +158,12 @@ const BASIS_NPZ_LIMIT: usize = 10_000_000;
 fn write(dir: &std::path::Path, red: &Reduction) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let model = &red.model;
+    let mut written = vec![dir.join("M.mtx"), dir.join("K.mtx"), dir.join("reduced.npz"), dir.join("dofs.csv")];
     mtx::write(&dir.join("M.mtx"), &model.mass)?;
     mtx::write(&dir.join("K.mtx"), &model.stiffness)?;
     if let Damping::Matrix(d) = &model.damping {
         mtx::write(&dir.join("D.mtx"), d)?;
+        written.push(dir.join("D.mtx"));
     }
     let basis = (red.basis.nrows() * red.basis.ncols() <= BASIS_NPZ_LIMIT).then_some(&red.basis);
     npz::write(&dir.join("reduced.npz"), model, &npz::NpzExtras { basis, retained: &red.retained })?;
@@ -171,5 +173,9 @@ fn write(dir: &std::path::Path, red: &Reduction) -> anyhow::Result<()> {
         if basis.is_some() { " (with the basis T)" } else { "" },
         dir.display()
     );
+    // A D.mtx of an earlier reduction would be read as this model's damping.
+    for old in stickslip_io::output::replace_previous_run(dir, "reduce", &written)? {
+        eprintln!("removed {} (written by the previous reduce, not by this one)", old.display());
+    }
     Ok(())
 }

@@ -7,7 +7,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_io::analysis::{describe_termination, run_grid, run_level, run_snapshot, LevelRun};
-use stickslip_io::output::{write_frf_csv, write_results, write_snapshots};
+use stickslip_io::output::{replace_previous_run, time_data_files, write_frf_csv, write_results, write_snapshots};
 use stickslip_io::report::write_report;
 use stickslip_io::study::Study;
 
@@ -32,6 +32,8 @@ pub struct Args {
 pub fn main(args: Args) -> anyhow::Result<()> {
     let study = Study::load(&args.study)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    // Every file this run writes, listed for the next run (see `replace_previous_run`).
+    let mut own_files = Vec::new();
     if let Some(mesh) = study.generated_mesh()? {
         // A generated geometry is written for CalculiX/Abaqus and Gmsh users to open, check or
         // reuse (the deck carries the couplings, connectors, shaker mass and spring), before
@@ -39,6 +41,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         let started = std::time::Instant::now();
         stickslip_fe::mesh::inp_writer::write(&mesh, args.out.join("model.inp"))?;
         stickslip_fe::mesh::gmsh_writer::write(&mesh, args.out.join("model.msh"))?;
+        own_files.extend([args.out.join("model.inp"), args.out.join("model.msh")]);
         if !args.quiet {
             eprintln!("mesh files (model.inp, model.msh): {:.2} s", started.elapsed().as_secs_f64());
         }
@@ -142,6 +145,14 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         let data = stickslip_io::analysis::report_data(&study, &model, &excitation, &runs, &files, timings.clone());
         let report = write_report(&args.out, &data).context("cannot write the report")?;
         eprintln!("report: {}", report.display());
+        own_files.push(report);
+    }
+    own_files.extend(files);
+    own_files.extend(time_data_files(&args.out, &levels));
+    for old in replace_previous_run(&args.out, "run", &own_files)? {
+        if !args.quiet {
+            eprintln!("removed {} (written by the previous run, not by this one)", old.display());
+        }
     }
     if !args.quiet {
         eprintln!(

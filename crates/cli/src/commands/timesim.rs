@@ -3,13 +3,16 @@
 //! frequency, or a swept sine over the study's `[sweep]` band.
 //!
 //! Files (SI units in the column names, frequencies in Hz):
-//! - `timesim_<level>N_<f>Hz.csv`: one steady period, `time_s, force_N`, per output
+//! - `timesim_<level>N_<f>Hz.csv`: the steady state over `--write-periods` periods (the
+//!   converged period repeated), `time_s, force_N`, per output
 //!   `<out>_m, <out>_m_s, <out>_m_s2`, per joint `<joint>_restoring_force_N` (the element's `g`
 //!   of Eq. 12; for a paper-form Jenkins joint `f − k_J u`) and `<joint>_slider_velocity_m_s`
 //!   (Eq. 33: 0 while stuck);
 //! - `timesim_summary.csv`: per level, the periods needed, the periodicity reached, the energy
 //!   input and dissipated per cycle (viscous, each joint) and the harmonic amplitudes of each output;
 //! - `sweep_<level>N.csv`: the same channels plus `frequency_Hz`, every `--record-every` steps;
+//! - `timesim_<level>N_<f>Hz.<png|svg>`, `sweep_<level>N.<png|svg>`: the outputs' displacements
+//!   against time (not with `--no-plots`);
 //! - `sweep_<level>N_cycles.csv`: per excitation cycle, first-harmonic amplitude and phase of
 //!   each output against the excitation;
 //! - with `--uff`, `sweep_<level>N.uff` instead of `sweep_<level>N.csv`: what the paper's
@@ -31,6 +34,7 @@ use stickslip_core::model::{Damping, Modes};
 use stickslip_core::timesim::{
     steady_state, swept_sine, Records, Scheme, SlowBand, SteadyState, SteadyStateOptions, SweepOptions, SweepRecord,
 };
+use stickslip_io::plot::plot_time_records;
 use stickslip_io::records::{add_white_noise, time_records_to_uff, write_table, write_time_csv, Channel, TimeRecords};
 use stickslip_io::study::{OutputSpec, Study};
 use stickslip_io::uff;
@@ -67,6 +71,12 @@ pub struct Args {
     /// Give up the steady state after this many periods.
     #[arg(long, default_value_t = 5000)]
     pub max_periods: usize,
+    /// Periods of a steady state written to its time record: the converged period repeated,
+    /// a stationary record as a test takes one, which `stickslip extract --stepped` reads
+    /// (it fits the complete cycles between the excitation's zero crossings, and one period
+    /// starting at the force's peak holds none).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub write_periods: u64,
     /// Harmonics reported for a steady state (default: the study's [hbm] harmonics).
     #[arg(long)]
     pub harmonics: Option<usize>,
@@ -100,6 +110,9 @@ pub struct Args {
     /// Seed of the noise (the same seed gives the same records).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Do not draw the outputs' displacements against time (in the study's plot format).
+    #[arg(long)]
+    pub no_plots: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, clap::ValueEnum)]
@@ -131,6 +144,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         None => excitation.levels_n.clone(),
     };
     let harmonics = args.harmonics.unwrap_or(study.hbm.harmonics);
+    let plots = (!args.no_plots).then_some(study.output_options.plot_format);
     let started = Instant::now();
     let mut written = Vec::new();
     // Levels (and frequencies) are independent runs: solved in parallel on the thread pool,
@@ -164,8 +178,16 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 let s = s?;
                 let path = args.out.join(format!("timesim_{level}N_{f}Hz.csv"));
                 let force: Vec<f64> = s.records.excitation.iter().map(|e| level * e).collect();
-                write_time_csv(&path, &time_records(&path, &outputs, &s.records, Some(&force), None)?)?;
+                let one_period = time_records(&path, &outputs, &s.records, Some(&force), None)?;
+                let records = repeated(one_period, args.write_periods as usize);
+                write_time_csv(&path, &records)?;
                 written.push(path);
+                if let Some(format) = plots {
+                    let plot = args.out.join(format!("timesim_{level}N_{f}Hz.{}", format.extension()));
+                    let title = format!("Steady state at {f} Hz, {level} N: displacements");
+                    plot_time_records(&plot, &title, &records, "m")?;
+                    written.push(plot);
+                }
                 let (cols, row) = summary_row(&model, &outputs, &s, level, harmonics)?;
                 columns = cols;
                 summary.push(row);
@@ -230,6 +252,12 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                     write_time_csv(&path, &records)?;
                 }
                 written.push(path);
+                if let Some(format) = plots {
+                    let plot = args.out.join(format!("sweep_{level}N.{}", format.extension()));
+                    let title = format!("Swept sine {f0}-{f1} Hz at {rate} Hz/s, {level} N: displacements");
+                    plot_time_records(&plot, &title, &records, "m")?;
+                    written.push(plot);
+                }
                 let path = args.out.join(format!("sweep_{level}N_cycles.csv"));
                 write_cycles(&path, &outputs, &dofs, &sweep)?;
                 written.push(path);
@@ -243,6 +271,9 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             }
         }
         _ => bail!("give either --frequency HZ[,HZ...] (steady states) or --sweep-rate HZ_PER_S (swept sine over the study's [sweep] band)"),
+    }
+    for old in stickslip_io::output::replace_previous_run(&args.out, "timesim", &written)? {
+        eprintln!("removed {} (written by the previous timesim, not by this one)", old.display());
     }
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     eprintln!("done in {:.2} s; wrote {}", started.elapsed().as_secs_f64(), names.join(", "));
@@ -372,6 +403,16 @@ fn time_records(
     }
     let dt = records.time[1] - records.time[0];
     Ok(TimeRecords { source: path.display().to_string(), start_s: records.time[0], sample_rate_hz: 1.0 / dt, channels })
+}
+
+/// `periods` copies of one steady period end to end. The steady state is periodic to the
+/// tolerance of its check, so the copies join as the integration would have continued; the
+/// record holds the period without its end point, so no sample is written twice.
+fn repeated(mut one_period: TimeRecords, periods: usize) -> TimeRecords {
+    for c in &mut one_period.channels {
+        c.values = c.values.repeat(periods);
+    }
+    one_period
 }
 
 /// One summary row: level, frequency, periods, periodicity, energies, harmonic amplitudes.

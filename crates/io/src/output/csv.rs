@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::{LevelResult, OutputError, Peak, PointRecord, SnapshotResult};
 
@@ -229,11 +229,26 @@ pub fn write_time_data(dir: &Path, levels: &[LevelResult]) -> Result<usize, Outp
                 std::fs::create_dir_all(&points_dir)
                     .map_err(|source| OutputError::Io { path: points_dir.clone(), source })?;
             }
-            write_point_csv(&points_dir.join(format!("level{i}_point{j}.csv")), p)?;
+            write_point_csv(&point_file(dir, i, j), p)?;
             written += 1;
         }
     }
     Ok(written)
+}
+
+/// The time data file of point `j` of level `i`.
+fn point_file(dir: &Path, i: usize, j: usize) -> PathBuf {
+    dir.join("points").join(format!("level{i}_point{j}.csv"))
+}
+
+/// The files [`write_time_data`] writes for `levels`.
+pub fn time_data_files(dir: &Path, levels: &[LevelResult]) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for (i, l) in levels.iter().enumerate() {
+        files
+            .extend(l.points.iter().enumerate().filter(|(_, p)| p.has_time_data()).map(|(j, _)| point_file(dir, i, j)));
+    }
+    files
 }
 
 /// Write `peaks.csv`: per level and output, the FRF peak (`level_N,output,frequency_Hz,

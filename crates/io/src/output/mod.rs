@@ -7,6 +7,7 @@
 //! round-trip exponent form (`{:e}`), so reading a file back gives the same `f64` bit for bit.
 
 mod csv;
+mod manifest;
 mod npz;
 
 use std::path::PathBuf;
@@ -17,9 +18,10 @@ use crate::study::PlotFormat;
 use std::path::Path;
 
 pub use csv::{
-    frf_columns, frf_row, write_bifurcations_csv, write_frf_csv, write_peaks_csv, write_point_csv, write_snapshot_csv,
-    write_time_data,
+    frf_columns, frf_row, time_data_files, write_bifurcations_csv, write_frf_csv, write_peaks_csv, write_point_csv,
+    write_snapshot_csv, write_time_data,
 };
+pub use manifest::{manifest_path, replace_previous_run};
 pub use npz::write_frf_npz;
 
 /// All converged points of one force level.
@@ -175,8 +177,8 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 
 /// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`,
 /// `peaks.csv` (see [`write_peaks_csv`]), the
-/// time data of the points that carry it (`points/`), and one FRF plot per output
-/// (`frf_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`], unless `plots`
+/// time data of the points that carry it (`points/`), and per output an FRF plot
+/// (`frf_<out>.<png|svg>`) and a phase plot (`frf_phase_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`], unless `plots`
 /// is `None` (batch runs). Returns the paths of the FRF table, the NPZ file and the plots.
 #[cfg(feature = "plot")]
 pub fn write_results(
@@ -199,6 +201,7 @@ pub fn write_results(
     write_time_data(dir, levels)?;
     if let Some(format) = plots {
         files.extend(crate::plot::plot_frfs(dir, levels, format)?);
+        files.extend(crate::plot::plot_frf_phases(dir, levels, format)?);
         files.extend(crate::plot::plot_level_details(dir, levels, format)?);
     }
     Ok(files)

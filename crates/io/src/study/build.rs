@@ -296,9 +296,9 @@ impl Study {
                 fe.model.damping = damping(at.section)?;
                 return Ok((FullModel::Mesh(fe), *at));
             }
-            ModelSpec::Mesh { path, material, at } => {
+            ModelSpec::Mesh { path, material, fixed, at } => {
                 let started = std::time::Instant::now();
-                let mut fe = read_mesh(path, material.as_ref()).map_err(|k| err(at.mass, k))?;
+                let mut fe = read_mesh(path, material.as_ref(), fixed).map_err(|k| err(at.mass, k))?;
                 timings.push(("mesh reading and assembly".into(), started.elapsed().as_secs_f64()));
                 fe.model.damping = damping(at.section)?;
                 check_mass_positive_definite(&fe.model.mass).map_err(|e| err(at.mass, model_error(e)))?;
@@ -569,8 +569,8 @@ fn replaced_stiffness(linear: &LinearModel, v: &[f64]) -> f64 {
     stiffness_along(linear, v) / (norm2 * norm2)
 }
 
-/// Read and assemble a mesh; `material` goes to every solid.
-fn read_mesh(path: &Path, material: Option<&MaterialSpec>) -> Result<FeModel, StudyErrorKind> {
+/// Read and assemble a mesh; `material` goes to every solid, `fixed` fixes DOFs by node set.
+fn read_mesh(path: &Path, material: Option<&MaterialSpec>, fixed: &[FixedSet]) -> Result<FeModel, StudyErrorKind> {
     let mesh_error = |source| StudyErrorKind::Mesh { context: "[model] mesh".into(), source };
     let is_msh = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("msh"));
     let mut mesh = if is_msh {
@@ -581,6 +581,23 @@ fn read_mesh(path: &Path, material: Option<&MaterialSpec>) -> Result<FeModel, St
     if let Some(m) = material {
         let material = Material { young: m.young, poisson: m.poisson, density: m.density };
         mesh.assign_material(None, "STUDY", material).map_err(mesh_error)?;
+    }
+    for f in fixed {
+        let Some(nodes) = mesh.node_set(&f.set) else {
+            let sets: Vec<&String> = mesh.node_sets.keys().collect();
+            return Err(StudyErrorKind::Invalid(format!(
+                "[model] fixed.{}: no node set (physical group) `{}` in {}; its sets are {sets:?}",
+                f.set,
+                f.set,
+                path.display()
+            )));
+        };
+        let dofs: Vec<(usize, u8)> = nodes.iter().flat_map(|&n| f.directions.iter().map(move |&d| (n, d))).collect();
+        for d in dofs {
+            if !mesh.fixed.contains(&d) {
+                mesh.fixed.push(d);
+            }
+        }
     }
     FeModel::assemble(mesh).map_err(|source| StudyErrorKind::Assembly { context: "[model] mesh".into(), source })
 }

@@ -50,8 +50,13 @@ pub(crate) struct RawModel {
     pub dof_file: Option<S<String>>,
     pub mesh: Option<S<String>>,
     pub material: Option<S<RawMaterial>>,
+    pub fixed: Option<S<RawFixed>>,
     pub harmony: Option<S<RawHarmony>>,
 }
+
+/// `fixed = { SET = [directions] }`: node sets (physical groups of a `.msh`) → directions
+/// fixed to zero.
+pub(crate) type RawFixed = std::collections::BTreeMap<String, S<Vec<S<i64>>>>;
 
 /// `[model.harmony]`: the generated Harmony-like assembly and the design values a study may
 /// change (the others keep the calibrated defaults of `stickslip_fe::harmony::Design`).

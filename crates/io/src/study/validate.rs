@@ -200,6 +200,42 @@ fn unique_names<'a>(src: &Source, names: impl Iterator<Item = &'a S<String>>, se
     Ok(())
 }
 
+/// `fixed = { SET = [directions], ... }`: each set's directions in 1..=6, at least one, no
+/// repeat; the sets themselves are checked against the mesh when it is read.
+fn fixed_sets(src: &Source, fixed: &S<raw::RawFixed>) -> Result<Vec<FixedSet>, StudyError> {
+    if fixed.get_ref().is_empty() {
+        return Err(src.invalid(
+            &fixed.span(),
+            "[model] fixed: no node set given; write e.g. `fixed = { ROOT = [1, 2, 3] }` (directions 1..6 = ux, uy, uz, rx, ry, rz)",
+        ));
+    }
+    let mut sets = Vec::new();
+    for (set, directions) in fixed.get_ref() {
+        let ctx = format!("[model] fixed.{set}");
+        if directions.get_ref().is_empty() {
+            return Err(src.invalid(
+                &directions.span(),
+                format!("{ctx}: no direction; give the fixed directions, e.g. [1, 2, 3] (ux, uy, uz)"),
+            ));
+        }
+        let mut dirs: Vec<u8> = Vec::new();
+        for d in directions.get_ref() {
+            let v = *d.get_ref();
+            if !(1..=6).contains(&v) {
+                return Err(
+                    src.invalid(&d.span(), format!("{ctx}: direction {v} is not one of 1..6 (ux, uy, uz, rx, ry, rz)"))
+                );
+            }
+            if dirs.contains(&(v as u8)) {
+                return Err(src.invalid(&d.span(), format!("{ctx}: direction {v} is given twice")));
+            }
+            dirs.push(v as u8);
+        }
+        sets.push(FixedSet { set: set.clone(), directions: dirs });
+    }
+    Ok(sets)
+}
+
 fn finite(src: &Source, v: &S<f64>, ctx: &str, key: &str) -> Result<f64, StudyError> {
     let x = *v.get_ref();
     if !x.is_finite() {
@@ -402,6 +438,14 @@ fn model(
             return Err(src.invalid(&mat.span(), format!("{CTX}: `material` goes with a `mesh`")));
         }
     }
+    if let Some(fixed) = &r.fixed {
+        if r.mesh.is_none() {
+            return Err(src.invalid(
+                &fixed.span(),
+                format!("{CTX}: `fixed` goes with a `mesh` (matrices are given without their fixed DOFs)"),
+            ));
+        }
+    }
     if let Some(mesh) = &r.mesh {
         for (key, given) in
             [("dofs", r.dofs.is_some()), ("dof_file", r.dof_file.is_some()), ("damping_file", damping_file.is_some())]
@@ -439,9 +483,13 @@ fn model(
                 format!("{CTX}: mesh {:?} must be an Abaqus/CalculiX .inp or a Gmsh .msh file", mesh.get_ref()),
             ));
         }
+        let fixed = match &r.fixed {
+            Some(f) => fixed_sets(src, f)?,
+            None => Vec::new(),
+        };
         let here = src.location(&mesh.span());
         let at = ModelLocations { section: at, mass: here, stiffness: here };
-        return Ok((ModelSpec::Mesh { path, material, at }, None));
+        return Ok((ModelSpec::Mesh { path, material, fixed, at }, None));
     }
     if inline {
         let (Some(dofs), Some(mass), Some(stiffness)) = (&r.dofs, &r.mass, &r.stiffness) else {
