@@ -3,6 +3,7 @@ pub mod condensed;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
+pub mod nonlinear_mode;
 pub mod receptance;
 pub mod sweep;
 
@@ -10,5 +11,8 @@ pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
+pub use nonlinear_mode::{
+    nonlinear_mode, Backbone, BackbonePoint, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
+};
 pub use receptance::Receptance;
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};
