@@ -50,11 +50,16 @@ pub fn run_nonlinear_mode<O: Observer + ?Sized>(
         mode: spec.mode - 1,
         hbm: CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples },
     };
-    // Steps are scaled arclengths in log10 of the amplitude (1 = the whole range): the
-    // continuation's defaults give at least 20 points over the range and refine at the
-    // corners of stick/slip transitions. Residuals are of order one (the balance is scaled
-    // by the amplitude), so the study's relative tolerance applies as it is.
+    // Steps are scaled arclengths in log10 of the amplitude (1 = the whole range): at most
+    // 1/20 of a decade (or of the range), so that the plots resolve the rise of damping at
+    // the first slip; the continuation refines at the corners of stick/slip transitions.
+    // Residuals are of order one (the balance is scaled by the amplitude), so the study's
+    // relative tolerance applies as it is.
+    let decades = (spec.amplitude_end / spec.amplitude_start).log10();
+    let max_step = (0.05 / decades).min(0.05);
     let options = Options {
+        max_step,
+        initial_step: max_step.min(1e-2),
         max_iterations: study.hbm.max_iterations,
         rtol: study.hbm.tolerance,
         max_points: spec.max_points,
