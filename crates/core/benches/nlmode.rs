@@ -7,7 +7,7 @@ use std::time::Instant;
 use faer::Mat;
 use stickslip_core::continuation::{Options, Silent};
 use stickslip_core::elements::{Element, Jenkins};
-use stickslip_core::hbm::{nonlinear_mode, HbmSettings, NonlinearModeSettings};
+use stickslip_core::hbm::{nonlinear_mode, HbmSettings, NegativeDamping, NonlinearModeSettings};
 use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel,
 };
@@ -80,26 +80,38 @@ fn main() {
     println!("stickslip nonlinear mode benchmark: N = 7, 300 samples, one thread, median of {runs} runs");
     for n in [137, 149] {
         let model = chain_with_joints(n, 4, false);
-        let settings = NonlinearModeSettings { mode: 0, hbm: HbmSettings { harmonics: 7, samples: 300 } };
-        // Four decades, from the stuck mode to joints slipping over most of the cycle.
+        let settings = NonlinearModeSettings {
+            mode: 0,
+            hbm: HbmSettings { harmonics: 7, samples: 300 },
+            negative_damping: NegativeDamping::TargetMode,
+        };
+        // Four decades, from the stuck mode to joints slipping over most of the cycle. The
+        // negative damping acts on the target mode only: with D = αM, −ξM would leave the 136
+        // other modes undamped, some near a harmonic of the mode (see NegativeDamping).
         let (a0, a1) = (1e-5, 1e-1);
-        let options = Options::default();
-        let mut times = Vec::new();
-        let mut last = None;
-        for _ in 0..runs {
-            let t = Instant::now();
-            let b = nonlinear_mode(&model, &settings, a0, a1, &[], &options, &mut Silent).unwrap();
-            times.push(t.elapsed().as_secs_f64());
-            last = Some(b);
-        }
-        times.sort_by(f64::total_cmp);
-        let b = last.unwrap();
-        let branch = b.branch.as_ref().unwrap();
-        let iterations: usize = branch.points.iter().map(|p| p.iterations).sum();
-        let (p0, p1) = (&b.points[0], b.points.last().unwrap());
-        let stick = p1.stick_fraction.iter().cloned().fold(f64::INFINITY, f64::min);
-        println!(
-            "{n} DOFs, q = 4, modal amplitude {a0:e}-{a1:e}: {:>8.3} ms/backbone {:>4} points {:>7.1} us/point {:.2} Newton it/point; \
+        // The continuation's default steps (at most 1/20 of the range, 0.2 decade), and the
+        // study's (at most 1/20 decade: `stickslip run`/`nlmode` draw smoother curves), both at
+        // the study's default tolerance (1e-8 of the order-one scaled residuals).
+        for (steps, options) in [
+            ("default steps", Options { rtol: 1e-8, ..Options::default() }),
+            ("1/20-decade steps", Options { rtol: 1e-8, max_step: 0.0125, initial_step: 0.01, ..Options::default() }),
+        ] {
+            let mut times = Vec::new();
+            let mut last = None;
+            for _ in 0..runs {
+                let t = Instant::now();
+                let b = nonlinear_mode(&model, &settings, a0, a1, &[], &options, &mut Silent).unwrap();
+                times.push(t.elapsed().as_secs_f64());
+                last = Some(b);
+            }
+            times.sort_by(f64::total_cmp);
+            let b = last.unwrap();
+            let branch = b.branch.as_ref().unwrap();
+            let iterations: usize = branch.points.iter().map(|p| p.iterations).sum();
+            let (p0, p1) = (&b.points[0], b.points.last().unwrap());
+            let stick = p1.stick_fraction.iter().cloned().fold(f64::INFINITY, f64::min);
+            println!(
+            "{n} DOFs, q = 4, modal amplitude {a0:e}-{a1:e}, {steps}: {:>8.3} ms/backbone {:>4} points {:>7.1} us/point {:.2} Newton it/point; \
              {:.3} -> {:.3} Hz, damping ratio {:.4} -> {:.4} (max {:.4}), least stick fraction at the end {stick:.2}; {}",
             times[runs / 2] * 1e3,
             b.points.len(),
@@ -112,5 +124,6 @@ fn main() {
             b.points.iter().map(|p| p.damping_ratio()).fold(0.0, f64::max),
             b.termination
         );
+        }
     }
 }

@@ -10,12 +10,17 @@ use hbm_support::*;
 use stickslip_core::continuation::{Options, Problem, Silent, TerminationReason};
 use stickslip_core::elements::{Element, Jenkins};
 use stickslip_core::hbm::{
-    nonlinear_mode, Backbone, BackbonePoint, HbmSettings, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
+    nonlinear_mode, Backbone, BackbonePoint, HbmSettings, NegativeDamping, NonlinearMode, NonlinearModeError,
+    NonlinearModeSettings,
 };
 use stickslip_core::model::{Damping, DofLabel, LinearModel, NonlinearModel};
 
 fn settings(mode: usize, harmonics: usize, samples: usize) -> NonlinearModeSettings {
-    NonlinearModeSettings { mode, hbm: HbmSettings { harmonics, samples } }
+    NonlinearModeSettings {
+        mode,
+        hbm: HbmSettings { harmonics, samples },
+        negative_damping: NegativeDamping::default(),
+    }
 }
 
 /// Three masses with Rayleigh damping (distinct modal damping per mode) and two Jenkins

@@ -11,7 +11,7 @@ use stickslip_core::continuation::{
 };
 use stickslip_core::hbm::{
     nonlinear_mode, sweep_frequency, sweep_level, Backbone, CondensedHbm, FrequencySweep,
-    HbmSettings as CoreHbmSettings, NonlinearModeError, NonlinearModeSettings, SweepError,
+    HbmSettings as CoreHbmSettings, NegativeDamping, NonlinearModeError, NonlinearModeSettings, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
@@ -49,6 +49,11 @@ pub fn run_nonlinear_mode<O: Observer + ?Sized>(
     let settings = NonlinearModeSettings {
         mode: spec.mode - 1,
         hbm: CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples },
+        negative_damping: if spec.target_mode_only {
+            NegativeDamping::TargetMode
+        } else {
+            NegativeDamping::MassProportional
+        },
     };
     // Steps are scaled arclengths in log10 of the amplitude (1 = the whole range): at most
     // 1/20 of a decade (or of the range), so that the plots resolve the rise of damping at

@@ -32,7 +32,10 @@ pub fn backbone_rows(backbone: &Backbone, n_joints: usize, harmonics: usize) -> 
             let mut row = vec![p.amplitude, p.frequency_hz(), p.damping_ratio(), p.energy_per_cycle];
             for j in 0..n_joints {
                 // A model without joints has none to report (the linear mode).
-                row.extend([p.stick_fraction.get(j).copied().unwrap_or(1.0), p.joint_energy.get(j).copied().unwrap_or(0.0)]);
+                row.extend([
+                    p.stick_fraction.get(j).copied().unwrap_or(1.0),
+                    p.joint_energy.get(j).copied().unwrap_or(0.0),
+                ]);
             }
             for (o, c) in p.outputs.iter().enumerate() {
                 row.push(c[0]);

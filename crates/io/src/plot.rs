@@ -402,7 +402,8 @@ fn draw_against_amplitude<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
     root.fill(&WHITE).map_err(e)?;
-    let kept: Vec<(f64, f64)> = points.iter().copied().filter(|(a, y)| a.is_finite() && *a > 0.0 && y.is_finite()).collect();
+    let kept: Vec<(f64, f64)> =
+        points.iter().copied().filter(|(a, y)| a.is_finite() && *a > 0.0 && y.is_finite()).collect();
     let (a0, a1) = min_max(kept.iter().map(|p| p.0));
     let (y0, y1) = min_max(kept.iter().map(|p| p.1));
     let x = if kept.is_empty() { 1e-6..1.0 } else { a0.max(f64::MIN_POSITIVE) * 1.05..a1 * 1.05 };
@@ -438,8 +439,10 @@ fn render_against_amplitude(path: &Path, title: &str, y_label: &str, points: &[(
     match path.extension().and_then(|x| x.to_str()) {
         Some("svg") => draw_against_amplitude(SVGBackend::new(path, SIZE).into_drawing_area(), title, y_label, points)
             .map_err(plot_error),
-        Some("png") => draw_against_amplitude(BitMapBackend::new(path, SIZE).into_drawing_area(), title, y_label, points)
-            .map_err(plot_error),
+        Some("png") => {
+            draw_against_amplitude(BitMapBackend::new(path, SIZE).into_drawing_area(), title, y_label, points)
+                .map_err(plot_error)
+        }
         _ => Err(plot_error("the plot file name must end in .png or .svg".into())),
     }
 }

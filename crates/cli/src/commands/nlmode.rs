@@ -90,7 +90,10 @@ pub fn compute_and_write(
         );
     }
     if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
-        anyhow::bail!("nonlinear mode: the branch {} (its points are written)", describe_termination(&backbone.termination));
+        anyhow::bail!(
+            "nonlinear mode: the branch {} (its points are written)",
+            describe_termination(&backbone.termination)
+        );
     }
     Ok(files)
 }

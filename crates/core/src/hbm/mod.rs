@@ -12,7 +12,7 @@ pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
 pub use nonlinear_mode::{
-    nonlinear_mode, Backbone, BackbonePoint, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
+    nonlinear_mode, Backbone, BackbonePoint, NegativeDamping, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
 };
 pub use receptance::Receptance;
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};

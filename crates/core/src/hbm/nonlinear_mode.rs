@@ -102,6 +102,8 @@ pub struct NonlinearMode<'m> {
     c_r: Vec<f64>,
     a: Mat<f64>,
     shapes: Mat<f64>,
+    /// The condensed modes see `−ξ` too ([`NegativeDamping::MassProportional`]).
+    shift_all: bool,
     q: usize,
     offsets: Vec<usize>,
     afts: Vec<ElementAft>,
@@ -123,12 +125,28 @@ pub struct NonlinearMode<'m> {
     pub evaluations: usize,
 }
 
+/// Which modes the negative damping `−ξ` acts on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NegativeDamping {
+    /// `−ξ M U̇` (Krack 2015, Eq. 2): every mode's damping is shifted by −ξ. With damping
+    /// proportional to M (the paper's `D = αM`) the other modes are then undamped at the linear
+    /// limit, and a dense spectrum puts some of them near a harmonic kΩ of the mode: the
+    /// condensed flexibility is nearly singular there.
+    #[default]
+    MassProportional,
+    /// `−ξ M φ_* φ_*ᵀ M U̇`: only the target mode is de-damped, the condensed modes keep their
+    /// damping. The same backbone where the other modes hardly move (a one-mode motion, e.g. a
+    /// 1-DOF system), and robust on models with many modes.
+    TargetMode,
+}
+
 /// A mode, a harmonic balance and where the branch goes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NonlinearModeSettings {
     /// Target mode, 0-based (mode 1 of a study file is 0 here).
     pub mode: usize,
     pub hbm: HbmSettings,
+    pub negative_damping: NegativeDamping,
 }
 
 /// One point of a backbone: the damped nonlinear mode at one amplitude.
@@ -235,6 +253,7 @@ impl<'m> NonlinearMode<'m> {
             c_r,
             a,
             shapes: modes.shapes,
+            shift_all: settings.negative_damping == NegativeDamping::MassProportional,
             q,
             offsets,
             afts,
@@ -348,6 +367,7 @@ impl<'m> NonlinearMode<'m> {
     /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives (modal sum over every mode but the target).
     fn receptances(&mut self, omega: f64, xi: f64) {
         let q = self.q;
+        let (xi, xi_weight) = if self.shift_all { (xi, 1.0) } else { (0.0, 0.0) };
         for k in 0..=self.plan.n_harmonics() {
             let kf = k as f64;
             let w = kf * omega;
@@ -365,7 +385,7 @@ impl<'m> NonlinearMode<'m> {
                 let inv2 = inv * inv;
                 // ∂(1/den)/∂Ω = k (2ω − i(c_r − ξ)) / den², ∂(1/den)/∂ξ = iω / den² (ω = kΩ).
                 let d_omega = c64::new(2.0 * w, -c) * inv2 * kf;
-                let d_xi = c64::new(0.0, w) * inv2;
+                let d_xi = c64::new(0.0, w * xi_weight) * inv2;
                 for i in 0..q {
                     let ai = self.a[(i, r)];
                     if ai == 0.0 {
@@ -417,7 +437,8 @@ impl<'m> NonlinearMode<'m> {
                         c64::new(self.eta(y, cos_index(k)), -self.eta(y, sin_index(k))) * amplitude
                     }
                 } else {
-                    let den = c64::new(self.omega_r[r] * self.omega_r[r] - w * w, w * (self.c_r[r] - xi));
+                    let shift = if self.shift_all { xi } else { 0.0 };
+                    let den = c64::new(self.omega_r[r] * self.omega_r[r] - w * w, w * (self.c_r[r] - shift));
                     let load: c64 = (0..q).map(|i| gk[i] * self.a[(i, r)]).sum();
                     -load / den
                 };
@@ -428,7 +449,9 @@ impl<'m> NonlinearMode<'m> {
         let mut viscous = 0.0;
         for r in 0..m {
             let s: f64 = (1..=nh).map(|k| (k * k) as f64 * modal[r][k].norm_sqr()).sum::<f64>() * pi * omega;
-            supplied += xi * s;
+            if self.shift_all || r == self.target {
+                supplied += xi * s;
+            }
             viscous += self.c_r[r] * s;
         }
         let mut joint_energy = Vec::with_capacity(self.model.elements.len());

@@ -61,6 +61,9 @@ pub struct NonlinearModeSpec {
     pub outputs: Vec<String>,
     /// Largest number of points of the branch (default 1000).
     pub max_points: usize,
+    /// `negative_damping = "target_mode"`: the negative damping acts on the target mode only,
+    /// not on every mode (`"mass"`, the default, Krack 2015's −ξM).
+    pub target_mode_only: bool,
     pub at: Location,
 }
 

@@ -211,4 +211,5 @@ pub(crate) struct RawNonlinearMode {
     pub amplitude_end: S<f64>,
     pub outputs: Option<S<Vec<String>>>,
     pub max_points: Option<S<i64>>,
+    pub negative_damping: Option<S<String>>,
 }

@@ -224,12 +224,26 @@ fn nonlinear_mode(
         Some(v) => count_at_most(src, v, CTX, "max_points", 2, MAX_BACKBONE_POINTS)?,
         None => 1000,
     };
+    let target_mode_only = match &r.negative_damping {
+        None => false,
+        Some(v) => match v.get_ref().as_str() {
+            "mass" => false,
+            "target_mode" => true,
+            other => {
+                return Err(src.invalid(
+                    &v.span(),
+                    format!("{CTX}: negative_damping must be \"mass\" or \"target_mode\", got {other:?}"),
+                ))
+            }
+        },
+    };
     Ok(NonlinearModeSpec {
         mode,
         amplitude_start,
         amplitude_end,
         outputs: names,
         max_points,
+        target_mode_only,
         at: src.location(&m.span()),
     })
 }
