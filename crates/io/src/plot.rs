@@ -381,18 +381,6 @@ pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat
     Ok(files)
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn ticks_at_round_off_of_zero_read_zero() {
-        // The tick at zero of a velocity axis [-0.14, 0.12] came out as -1.39e-17.
-        assert_eq!(super::tick(-1.39e-17, 0.26), "0");
-        assert_eq!(super::tick(0.05, 0.26), "0.05");
-        // A genuinely small tick on a small axis keeps its value.
-        assert_eq!(super::tick(2.0e-9, 1.0e-8), "2.00e-9");
-    }
-}
-
 /// One quantity against the modal amplitude on a log axis (a backbone spans decades).
 fn draw_against_amplitude<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
@@ -463,4 +451,16 @@ pub fn plot_backbone(
     let d_path = dir.join(format!("backbone_damping.{ext}"));
     render_against_amplitude(&d_path, &format!("Nonlinear mode {mode}: damping ratio"), "damping ratio ζ", &damping)?;
     Ok(vec![f_path, d_path])
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_at_round_off_of_zero_read_zero() {
+        // The tick at zero of a velocity axis [-0.14, 0.12] came out as -1.39e-17.
+        assert_eq!(super::tick(-1.39e-17, 0.26), "0");
+        assert_eq!(super::tick(0.05, 0.26), "0.05");
+        // A genuinely small tick on a small axis keeps its value.
+        assert_eq!(super::tick(2.0e-9, 1.0e-8), "2.00e-9");
+    }
 }

@@ -86,6 +86,8 @@ pub enum NonlinearModeError {
     NonlinearStart { amplitude: f64, linear_hz: f64, frequency_shift: f64, linear_ratio: f64, damping_shift: f64 },
     #[error("no periodic solution at the first amplitude {amplitude:e} (the linear mode did not converge: {reason}); start at a smaller amplitude")]
     FirstPointFailed { amplitude: f64, reason: String },
+    #[error("the converged point at amplitude {amplitude:e} could not be evaluated again for its results: {reason}")]
+    PostProcessing { amplitude: f64, reason: String },
 }
 
 /// The EPMC balance of one mode of a model, as a continuation [`Problem`] in `λ = log10 a`.
@@ -409,7 +411,7 @@ impl<'m> NonlinearMode<'m> {
         let (omega, xi) = self.frequency_and_xi(y);
         let mut r = vec![0.0; self.dimension()];
         self.evaluate(y, lambda, &mut r, None)
-            .map_err(|e| NonlinearModeError::FirstPointFailed { amplitude, reason: e.message })?;
+            .map_err(|e| NonlinearModeError::PostProcessing { amplitude, reason: e.message })?;
         let q = self.q;
         let (nh, nc, nt) = (self.plan.n_harmonics(), self.plan.n_coeffs(), self.plan.n_samples());
         let m = self.omega_r.len();
