@@ -380,6 +380,9 @@ fn single_mode_theory_gives_the_forced_response() {
         }
         for (lo, hi) in [(0.5 * w, w), (w, 1.5 * w)] {
             let (mut lo, mut hi) = (lo, hi);
+            if f(lo) * f(hi) > 0.0 {
+                continue; // no crossing on this side (e.g. below the static response)
+            }
             let rising = f(hi) > f(lo);
             for _ in 0..200 {
                 let mid = 0.5 * (lo + hi);
@@ -399,13 +402,18 @@ fn single_mode_theory_gives_the_forced_response() {
             x0[sin_index(1)] = s1;
             let (sol, _) = hbm.solve(omega, F_EXCIT, &x0, 1e-14, 50).unwrap();
             let amplitude = sol[cos_index(1)].hypot(sol[sin_index(1)]);
-            worst = worst.max((amplitude / x - 1.0).abs());
+            let e = (amplitude / x - 1.0).abs();
+            if e > 1e-6 {
+                eprintln!("x {x:.4e} at {:.4} Hz: forced {amplitude:.6e} ({e:.2e})", omega / (2.0 * PI));
+            }
+            worst = worst.max(e);
             compared += 1;
         }
     }
     eprintln!("{compared} frequencies: worst relative amplitude difference {worst:.3e}");
     assert!(compared >= 10, "{compared}");
     // Both balances are exact up to the AFT quadrature (7e-9 at 16384 samples) and Newton's
-    // tolerances (1e-10 on the backbone, 1e-14 forced).
+    // tolerances (1e-10 on the backbone, 1e-14 forced); measured 5.0e-8 over 65 frequencies
+    // (both sides of the peak, 1.2e-5 to 1e-3 m).
     assert!(worst < 1e-6, "{worst:e}");
 }
