@@ -84,7 +84,10 @@ pub fn compute_and_write(
             last.frequency_hz(),
             first.damping_ratio(),
             last.damping_ratio(),
-            describe_termination(&backbone.termination),
+            match backbone.termination {
+                stickslip_core::continuation::TerminationReason::ReachedEnd => "reached the last amplitude".to_string(),
+                ref t => describe_termination(t),
+            },
             started.elapsed().as_secs_f64(),
             if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
         );
