@@ -27,6 +27,7 @@
 //! H_rest(ω; ξ) = Σ_{r ≠ *} a_r a_rᵀ / (ω_r² − ω² + i ω (c_r − ξ))
 //! ```
 //!
+//! With [`NegativeDamping::TargetMode`] the condensed modes keep `c_r` (ξ acts on η only).
 //! `G` are the harmonics of the element forces by AFT ([`super::element_aft`]). Elements in the
 //! paper's form (Eq. 11) return forces net of the stiffness they replace in K, so a stuck joint
 //! gives `G = 0` and the linear mode solves the balance exactly.
