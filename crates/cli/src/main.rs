@@ -23,6 +23,8 @@ struct Cli {
 enum Command {
     /// Frequency response of a study at every force level (harmonic balance + continuation).
     Run(commands::run::Args),
+    /// Backbone of a study's [nonlinear_mode]: frequency and damping ratio of a damped nonlinear mode against amplitude.
+    Nlmode(commands::nlmode::Args),
     /// Lowest modes of a model (mesh, CalculiX deck or matrices).
     Modes(commands::modes::Args),
     /// Reduce a model (Craig-Bampton, free-mode variant, slipped-joint enrichment).
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Run(a) => commands::run::main(a),
+        Command::Nlmode(a) => commands::nlmode::main(a),
         Command::Modes(a) => commands::modes::main(a),
         Command::Reduce(a) => commands::reduce::main(a),
         Command::Timesim(a) => commands::timesim::main(a),

@@ -11,8 +11,9 @@ use stickslip_core::continuation::{
 };
 use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::{
-    bifurcations, stability_at, sweep_frequency, sweep_level, BranchStabilityError, CondensedHbm, FrequencySweep,
-    HbmSettings as CoreHbmSettings, Hill, HillSettings, SweepError,
+    bifurcations, nonlinear_mode, stability_at, sweep_frequency, sweep_level, Backbone, BranchStabilityError,
+    CondensedHbm, FrequencySweep, HbmSettings as CoreHbmSettings, Hill, HillSettings, NegativeDamping,
+    NonlinearModeError, NonlinearModeSettings, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
@@ -30,6 +31,52 @@ use crate::study::{
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+
+/// The backbone of a study's `[nonlinear_mode]` (`None` without that section), with the
+/// names of its outputs (the section's, or every output of the study) in the order of the
+/// points' output harmonics.
+pub fn run_nonlinear_mode<O: Observer + ?Sized>(
+    study: &Study,
+    model: &NonlinearModel,
+    outputs: &[OutputSpec],
+    observer: &mut O,
+) -> Option<Result<(Backbone, Vec<String>), NonlinearModeError>> {
+    let spec = study.nonlinear_mode.as_ref()?;
+    let chosen: Vec<&OutputSpec> = if spec.outputs.is_empty() {
+        outputs.iter().collect()
+    } else {
+        spec.outputs.iter().filter_map(|n| outputs.iter().find(|o| &o.name == n)).collect()
+    };
+    let vectors: Vec<&[f64]> = chosen.iter().map(|o| o.vector.as_slice()).collect();
+    let settings = NonlinearModeSettings {
+        mode: spec.mode - 1,
+        hbm: CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples },
+        negative_damping: if spec.target_mode_only {
+            NegativeDamping::TargetMode
+        } else {
+            NegativeDamping::MassProportional
+        },
+    };
+    // Steps are scaled arclengths in log10 of the amplitude (1 = the whole range): at most
+    // 1/20 of a decade (or of the range), so that the plots resolve the rise of damping at
+    // the first slip; the continuation refines at the corners of stick/slip transitions.
+    // Residuals are of order one (the balance is scaled by the amplitude), so the study's
+    // relative tolerance applies as it is.
+    let decades = (spec.amplitude_end / spec.amplitude_start).log10();
+    let max_step = (0.05 / decades).min(0.05);
+    let options = Options {
+        max_step,
+        initial_step: max_step.min(1e-2),
+        max_iterations: study.hbm.max_iterations,
+        rtol: study.hbm.tolerance,
+        max_points: spec.max_points,
+        ..Options::default()
+    };
+    let result =
+        nonlinear_mode(model, &settings, spec.amplitude_start, spec.amplitude_end, &vectors, &options, observer)
+            .map(|b| (b, chosen.iter().map(|o| o.name.clone()).collect()));
+    Some(result)
+}
 
 /// The result of one level: the records of every converged point, and why the branch ended.
 pub struct LevelRun {

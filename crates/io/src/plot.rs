@@ -739,6 +739,78 @@ fn draw_comparison<DB: DrawingBackend>(
     root.present().map_err(e)
 }
 
+/// One quantity against the modal amplitude on a log axis (a backbone spans decades).
+fn draw_against_amplitude<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    y_label: &str,
+    points: &[(f64, f64)],
+) -> Result<(), String> {
+    let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let kept: Vec<(f64, f64)> =
+        points.iter().copied().filter(|(a, y)| a.is_finite() && *a > 0.0 && y.is_finite()).collect();
+    let (a0, a1) = min_max(kept.iter().map(|p| p.0));
+    let (y0, y1) = min_max(kept.iter().map(|p| p.1));
+    let x = if kept.is_empty() { 1e-6..1.0 } else { a0.max(f64::MIN_POSITIVE) * 1.05..a1 * 1.05 };
+    let x = log_axis(x.start / 1.05, x.end / 1.05);
+    let (y0, y1) = if kept.is_empty() { (0.0, 1.0) } else { (y0, y1) };
+    let pad = 0.05 * (y1 - y0).max(1e-3 * y0.abs().max(y1.abs())).max(f64::MIN_POSITIVE);
+    let y = linear_axis(y0 - pad, y1 + pad);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FONT, 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x.log_scale(), y.clone())
+        .map_err(e)?;
+    let span = y.end - y.start;
+    chart
+        .configure_mesh()
+        .x_desc("modal amplitude (m·√kg)")
+        .y_desc(y_label)
+        .x_label_formatter(&|a| format!("{a:.0e}"))
+        .y_label_formatter(&|v| tick(*v, span))
+        .label_style((FONT, 15))
+        .draw()
+        .map_err(e)?;
+    let color = Palette99::pick(0).to_rgba();
+    chart.draw_series(LineSeries::new(kept.iter().copied(), color.stroke_width(2))).map_err(e)?;
+    chart.draw_series(kept.iter().map(|&p| Circle::new(p, 2, color.filled()))).map_err(e)?;
+    root.present().map_err(e)
+}
+
+fn render_against_amplitude(path: &Path, title: &str, y_label: &str, points: &[(f64, f64)]) -> Result<(), OutputError> {
+    let plot_error = |m: String| OutputError::Plot(format!("{}: {m}", path.display()));
+    match path.extension().and_then(|x| x.to_str()) {
+        Some("svg") => draw_against_amplitude(SVGBackend::new(path, SIZE).into_drawing_area(), title, y_label, points)
+            .map_err(plot_error),
+        Some("png") => {
+            draw_against_amplitude(BitMapBackend::new(path, SIZE).into_drawing_area(), title, y_label, points)
+                .map_err(plot_error)
+        }
+        _ => Err(plot_error("the plot file name must end in .png or .svg".into())),
+    }
+}
+
+/// The backbone of a nonlinear mode: `backbone_frequency` (Hz) and `backbone_damping`
+/// (damping ratio ζ = ξ/2Ω) against the modal amplitude (log axis), in `dir`.
+pub fn plot_backbone(
+    dir: &Path,
+    backbone: &stickslip_core::hbm::Backbone,
+    format: PlotFormat,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mode = backbone.mode + 1;
+    let ext = format.extension();
+    let frequency: Vec<(f64, f64)> = backbone.points.iter().map(|p| (p.amplitude, p.frequency_hz())).collect();
+    let damping: Vec<(f64, f64)> = backbone.points.iter().map(|p| (p.amplitude, p.damping_ratio())).collect();
+    let f_path = dir.join(format!("backbone_frequency.{ext}"));
+    render_against_amplitude(&f_path, &format!("Nonlinear mode {mode}: frequency"), "frequency (Hz)", &frequency)?;
+    let d_path = dir.join(format!("backbone_damping.{ext}"));
+    render_against_amplitude(&d_path, &format!("Nonlinear mode {mode}: damping ratio"), "damping ratio ζ", &damping)?;
+    Ok(vec![f_path, d_path])
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -39,6 +39,7 @@ fn every_key_is_documented() {
         "[continuation]",
         "[[output]]",
         "[output_options]",
+        "[nonlinear_mode]",
     ];
     let mut checked = 0;
     for section in sections {

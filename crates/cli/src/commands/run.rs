@@ -132,6 +132,17 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         files.push(path);
     }
     timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
+    // The [nonlinear_mode] backbone, when the study asks for one; a failure is reported at the
+    // end with the incomplete levels, after everything else is written.
+    let backbone_started = Instant::now();
+    let backbone = study
+        .nonlinear_mode
+        .as_ref()
+        .map(|_| super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet));
+    if let Some(Ok(written)) = &backbone {
+        files.extend(written.iter().cloned());
+        timings.push(("nonlinear mode".into(), backbone_started.elapsed().as_secs_f64()));
+    }
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
         "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, peaks.csv{}, points/)",
@@ -176,6 +187,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .filter_map(Result::err)
         .chain(failed_grid.into_iter().filter_map(Result::err))
         .map(|e| e.to_string())
+        .chain(backbone.and_then(Result::err).map(|e| format!("{e:#}")))
         .collect();
     if !incomplete.is_empty() || !failed.is_empty() {
         let mut what = Vec::new();
@@ -183,7 +195,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             what.push(format!("{} level(s) did not cross the band (their points are written)", incomplete.len()));
         }
         if !failed.is_empty() {
-            what.push(format!("{} snapshot(s) or grid level(s) failed", failed.len()));
+            what.push(format!("{} snapshot(s), grid level(s) or nonlinear mode failed", failed.len()));
         }
         anyhow::bail!(
             "{}:\n  {}",

@@ -4,6 +4,7 @@ pub mod condensed;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
+pub mod nonlinear_mode;
 pub mod receptance;
 pub mod stability;
 pub mod sweep;
@@ -13,6 +14,9 @@ pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
+pub use nonlinear_mode::{
+    nonlinear_mode, Backbone, BackbonePoint, NegativeDamping, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
+};
 pub use receptance::Receptance;
 pub use stability::{Hill, HillSettings, Stability, StabilityError};
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};

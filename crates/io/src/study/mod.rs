@@ -44,6 +44,27 @@ pub struct Study {
     /// `[grid] frequencies_hz`: frequencies (Hz) solved one by one at every level, besides the
     /// sweeps (empty: none).
     pub grid_hz: Vec<f64>,
+    /// `[nonlinear_mode]`: a backbone to compute besides (or instead of) the sweeps.
+    pub nonlinear_mode: Option<NonlinearModeSpec>,
+}
+
+/// `[nonlinear_mode]`: the damped nonlinear mode of one mode of the model over a range of
+/// modal amplitudes (extended periodic motion concept, see docs/nonlinear-modes.md).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonlinearModeSpec {
+    /// Mode number, from 1 (lowest frequency).
+    pub mode: usize,
+    /// Modal amplitude range (m·√kg, mass-normalised modal coordinate), start < end.
+    pub amplitude_start: f64,
+    pub amplitude_end: f64,
+    /// Names of `[[output]]`s whose harmonics are reported (empty: every output).
+    pub outputs: Vec<String>,
+    /// Largest number of points of the branch (default 1000).
+    pub max_points: usize,
+    /// `negative_damping = "target_mode"`: the negative damping acts on the target mode only,
+    /// not on every mode (`"mass"`, the default, Krack 2015's −ξM).
+    pub target_mode_only: bool,
+    pub at: Location,
 }
 
 /// Line and column (both from 1) of a key in the study file.

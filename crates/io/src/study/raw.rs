@@ -28,6 +28,7 @@ pub(crate) struct RawStudy {
     #[serde(default)]
     pub snapshot: Vec<S<RawSnapshot>>,
     pub grid: Option<S<RawGrid>>,
+    pub nonlinear_mode: Option<S<RawNonlinearMode>>,
 }
 
 /// A matrix written inline: a list of rows, or a list of diagonal values.
@@ -205,4 +206,16 @@ pub(crate) enum RawTimeData {
 pub(crate) struct RawOutputOptions {
     pub time_data: Option<S<RawTimeData>>,
     pub plot_format: Option<S<String>>,
+}
+
+/// `[nonlinear_mode]`: the backbone of one mode (extended periodic motion concept).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawNonlinearMode {
+    pub mode: S<i64>,
+    pub amplitude_start: S<f64>,
+    pub amplitude_end: S<f64>,
+    pub outputs: Option<S<Vec<String>>>,
+    pub max_points: Option<S<i64>>,
+    pub negative_damping: Option<S<String>>,
 }

@@ -160,6 +160,8 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         });
     }
 
+    let nonlinear_mode = raw.nonlinear_mode.as_ref().map(|m| nonlinear_mode(&src, m, &outputs)).transpose()?;
+
     Ok(Study {
         path: file.to_path_buf(),
         model,
@@ -175,6 +177,74 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         output_options,
         snapshots,
         grid_hz,
+        nonlinear_mode,
+    })
+}
+
+/// Most points of a backbone.
+const MAX_BACKBONE_POINTS: i64 = 100_000;
+
+fn nonlinear_mode(
+    src: &Source,
+    m: &S<raw::RawNonlinearMode>,
+    outputs: &[OutputSelector],
+) -> Result<NonlinearModeSpec, StudyError> {
+    const CTX: &str = "[nonlinear_mode]";
+    let r = m.get_ref();
+    let mode = count(src, &r.mode, CTX, "mode", 1)?;
+    let amplitude_start = positive(src, &r.amplitude_start, CTX, "amplitude_start", " m·√kg")?;
+    let amplitude_end = positive(src, &r.amplitude_end, CTX, "amplitude_end", " m·√kg")?;
+    if amplitude_end <= amplitude_start {
+        return Err(src.invalid(
+            &r.amplitude_end.span(),
+            format!(
+                "{CTX}: amplitude_end must be larger than amplitude_start (the branch starts from the linear mode at small amplitude), got {amplitude_end} <= {amplitude_start}"
+            ),
+        ));
+    }
+    let names = match &r.outputs {
+        None => Vec::new(),
+        Some(list) => {
+            for name in list.get_ref() {
+                if !outputs.iter().any(|o| &o.name == name) {
+                    let known: Vec<&str> = outputs.iter().map(|o| o.name.as_str()).collect();
+                    return Err(src.invalid(
+                        &list.span(),
+                        format!(
+                            "{CTX}: outputs names {name:?}, which is no [[output]] (outputs are: {})",
+                            if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                        ),
+                    ));
+                }
+            }
+            list.get_ref().clone()
+        }
+    };
+    let max_points = match &r.max_points {
+        Some(v) => count_at_most(src, v, CTX, "max_points", 2, MAX_BACKBONE_POINTS)?,
+        None => 1000,
+    };
+    let target_mode_only = match &r.negative_damping {
+        None => false,
+        Some(v) => match v.get_ref().as_str() {
+            "mass" => false,
+            "target_mode" => true,
+            other => {
+                return Err(src.invalid(
+                    &v.span(),
+                    format!("{CTX}: negative_damping must be \"mass\" or \"target_mode\", got {other:?}"),
+                ))
+            }
+        },
+    };
+    Ok(NonlinearModeSpec {
+        mode,
+        amplitude_start,
+        amplitude_end,
+        outputs: names,
+        max_points,
+        target_mode_only,
+        at: src.location(&m.span()),
     })
 }
 

@@ -1,0 +1,102 @@
+//! `stickslip nlmode STUDY.toml --out DIR`: the backbone of the study's `[nonlinear_mode]`
+//! (extended periodic motion concept): `backbone.csv` and plots of frequency and damping ratio
+//! against the modal amplitude.
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use stickslip_core::continuation::Point;
+use stickslip_core::model::NonlinearModel;
+use stickslip_io::analysis::{describe_termination, run_nonlinear_mode};
+use stickslip_io::backbone::write_backbone_csv;
+use stickslip_io::study::{OutputSpec, PlotFormat, Study};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The study file (TOML, with a [nonlinear_mode] section; see docs/nonlinear-modes.md).
+    pub study: PathBuf,
+    /// Output directory (created if needed).
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// No progress messages.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Do not draw plots.
+    #[arg(long)]
+    pub no_plots: bool,
+}
+
+pub fn main(args: Args) -> anyhow::Result<()> {
+    let study = Study::load(&args.study)?;
+    if study.nonlinear_mode.is_none() {
+        anyhow::bail!(
+            "{}: the study has no [nonlinear_mode] section (keys: mode, amplitude_start, amplitude_end; see docs/nonlinear-modes.md)",
+            args.study.display()
+        );
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let (model, _, outputs) = study.build_model()?;
+    let plots = (!args.no_plots).then_some(study.output_options.plot_format);
+    compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet)?;
+    Ok(())
+}
+
+/// Compute the backbone of `study`'s `[nonlinear_mode]` (nothing without one) and write
+/// `backbone.csv` and, with `plots`, its two plots into `out`. Returns the files written.
+pub fn compute_and_write(
+    study: &Study,
+    model: &NonlinearModel,
+    outputs: &[OutputSpec],
+    out: &Path,
+    plots: Option<PlotFormat>,
+    quiet: bool,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let started = Instant::now();
+    let mut observer = |p: &Point, _: f64| {
+        if !quiet {
+            eprint!("\rnonlinear mode: modal amplitude {:.3e}   ", 10f64.powf(p.lambda));
+        }
+    };
+    let Some(result) = run_nonlinear_mode(study, model, outputs, &mut observer) else { return Ok(Vec::new()) };
+    if !quiet {
+        eprintln!();
+    }
+    let (backbone, names) = result.context("nonlinear mode")?;
+    for note in &backbone.notes {
+        eprintln!("nonlinear mode: {note}");
+    }
+    let joints: Vec<String> = model.elements.iter().map(|e| e.name.clone()).collect();
+    let csv = out.join("backbone.csv");
+    write_backbone_csv(&csv, &backbone, &joints, &names, study.hbm.harmonics)?;
+    let mut files = vec![csv];
+    if let Some(format) = plots {
+        files.extend(stickslip_io::plot::plot_backbone(out, &backbone, format)?);
+    }
+    let (first, last) = (backbone.points.first(), backbone.points.last());
+    if let (Some(first), Some(last)) = (first, last) {
+        eprintln!(
+            "nonlinear mode {}: {} points, modal amplitude {:.3e}-{:.3e} m·√kg, {:.4}-{:.4} Hz, damping ratio {:.4e}-{:.4e}, {} in {:.3} s; wrote backbone.csv{}",
+            backbone.mode + 1,
+            backbone.points.len(),
+            first.amplitude,
+            last.amplitude,
+            first.frequency_hz(),
+            last.frequency_hz(),
+            first.damping_ratio(),
+            last.damping_ratio(),
+            match backbone.termination {
+                stickslip_core::continuation::TerminationReason::ReachedEnd => "reached the last amplitude".to_string(),
+                ref t => describe_termination(t),
+            },
+            started.elapsed().as_secs_f64(),
+            if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
+        );
+    }
+    if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
+        anyhow::bail!(
+            "nonlinear mode: the branch {} (its points are written)",
+            describe_termination(&backbone.termination)
+        );
+    }
+    Ok(files)
+}
