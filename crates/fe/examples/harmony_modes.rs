@@ -36,16 +36,16 @@ fn set(design: &mut Design, key: &str, v: f64) {
         "hub_outer_radius" => design.hub_outer_radius = v,
         "screw_radius_1" => design.screw_radii[0] = v,
         "screw_radius_2" => design.screw_radii[1] = v,
-        "body_flange_radius" => design.body_flange_radius = Some(v),
-        "top_disk_thickness" => design.top_disk_thickness = Some(v),
-        "rim_width" => design.rim_width = v,
+        "body_flange_radius" => design.variant.body_flange_radius = Some(v),
+        "top_disk_thickness" => design.variant.top_disk_thickness = Some(v),
+        "rim_width" => design.variant.rim_width = v,
         "top_disk_inner_radius" => {
-            design.top_disk_inner = Some((v, design.top_disk_inner.map_or(0.0, |i| i.1)));
+            design.variant.top_disk_inner = Some((v, design.variant.top_disk_inner.map_or(0.0, |i| i.1)));
         }
         "top_disk_inner_thickness" => {
-            design.top_disk_inner = Some((design.top_disk_inner.map_or(0.0, |i| i.0), v));
+            design.variant.top_disk_inner = Some((design.variant.top_disk_inner.map_or(0.0, |i| i.0), v));
         }
-        "blade_height" => design.blade_height = Some(v),
+        "blade_height" => design.variant.blade_height = Some(v),
         other => panic!("unknown key {other}"),
     }
 }

@@ -21,8 +21,8 @@
 //!   second axial mode (878.4 Hz).
 //!
 //! The body substructure of Table 4 (synchronous axial mode 210.8 Hz, four asynchronous blade
-//! modes at 254-260 Hz) is not met by this design; optional dimensions (`body_flange_radius`,
-//! `top_disk_thickness`, `top_disk_inner`, `rim_width`, `blade_height`) build the variants that
+//! modes at 254-260 Hz) is not met by this design; the optional geometry of [`BodyVariant`]
+//! (a split flange, a thin, stepped or rimmed top disk, blades on edge) builds the variants that
 //! docs/harmony.md measures to show why.
 //!
 //! Modelling as Section 3.1: reference nodes rigidly drive the screw zones (radius 10 mm) on
@@ -124,26 +124,13 @@ pub struct Design {
     pub hub_outer_radius: f64,
     pub hub_inner_radius: f64,
     pub diaphragm_thickness: f64,
-    /// Outer radius of the body's flange: the diaphragm from the hub to this radius is the body's,
-    /// from it to the bottom ring the envelope's inner web (counted in the envelope's mass). The
-    /// body substructure (Table 4) is clamped on this circle. `None`: the whole diaphragm is the
-    /// body's, clamped at the bottom ring.
-    pub body_flange_radius: Option<f64>,
-    /// Top disk thickness; `None`: from the body mass. Given, the rest of the body mass is in a
-    /// rim ring under the disk's edge, `rim_width` wide, or, if `rim_width` is 0, in the hub tube
-    /// (its inner radius follows).
-    pub top_disk_thickness: Option<f64>,
-    pub rim_width: f64,
-    /// A thinner inner zone of the top disk (with `top_disk_thickness` given and no rim): its
-    /// outer radius and thickness; the hub stops under it.
-    pub top_disk_inner: Option<(f64, f64)>,
+    /// Optional body geometry (the variants docs/harmony.md measures for Table 4); the default
+    /// is the design's. Boxed: a study keeps a `Design` by value.
+    pub variant: Box<BodyVariant>,
     /// Blade length (Table 1: 118 mm), mass (0.1086 kg), thickness; the width follows.
     pub blade_length: f64,
     pub blade_mass: f64,
     pub blade_thickness: f64,
-    /// Blades standing on edge: a plate `blade_height` high (vertical), its thickness
-    /// (tangential) from the mass; `blade_thickness` is then not used. `None`: flat blades.
-    pub blade_height: Option<f64>,
     /// Radii of the two screws of each blade.
     pub screw_radii: [f64; 2],
     /// Radius of the zones the screw references drive (paper: 10 mm).
@@ -181,14 +168,10 @@ impl Default for Design {
             hub_outer_radius: 0.060,
             hub_inner_radius: 0.054,
             diaphragm_thickness: 0.00431,
-            body_flange_radius: None,
-            top_disk_thickness: None,
-            rim_width: 0.02,
-            top_disk_inner: None,
+            variant: Box::default(),
             blade_length: 0.118,
             blade_mass: 0.1086,
             blade_thickness: 0.0088,
-            blade_height: None,
             screw_radii: [0.105, 0.135],
             screw_zone_radius: 0.010,
             contact_zone_half_height: 0.010,
@@ -200,6 +183,39 @@ impl Default for Design {
             steel_304l: Material { young: 193e9, poisson: 0.29, density: 7900.0 },
             aluminium_2017a: Material { young: 72.5e9, poisson: 0.33, density: 2790.0 },
             blade_steel: Material { young: 196e9, poisson: 0.272, density: 7780.0 },
+        }
+    }
+}
+
+/// Optional geometry of the body and blades, for the study of the body substructure (Table 4).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyVariant {
+    /// Outer radius of the body's flange: the diaphragm from the hub to this radius is the body's,
+    /// from it to the bottom ring the envelope's inner web (counted in the envelope's mass). The
+    /// body substructure is clamped on this circle. `None`: the whole diaphragm is the body's,
+    /// clamped at the bottom ring.
+    pub body_flange_radius: Option<f64>,
+    /// Top disk thickness; `None`: from the body mass. Given, the rest of the body mass is in a
+    /// rim ring under the disk's edge, `rim_width` wide, or, if `rim_width` is 0, in the hub tube
+    /// (its inner radius follows).
+    pub top_disk_thickness: Option<f64>,
+    pub rim_width: f64,
+    /// A thinner inner zone of the top disk (with `top_disk_thickness` given and no rim): its
+    /// outer radius and thickness; the hub stops under it.
+    pub top_disk_inner: Option<(f64, f64)>,
+    /// Blades standing on edge: a plate `blade_height` high (vertical), its thickness
+    /// (tangential) from the mass; `blade_thickness` is then not used. `None`: flat blades.
+    pub blade_height: Option<f64>,
+}
+
+impl Default for BodyVariant {
+    fn default() -> Self {
+        BodyVariant {
+            body_flange_radius: None,
+            top_disk_thickness: None,
+            rim_width: 0.02,
+            top_disk_inner: None,
+            blade_height: None,
         }
     }
 }
@@ -262,7 +278,7 @@ impl Design {
             ("blade_length", self.blade_length),
             ("blade_mass", self.blade_mass),
             ("blade_thickness", self.blade_thickness),
-            ("blade_height", self.blade_height.unwrap_or(1.0)),
+            ("blade_height", self.variant.blade_height.unwrap_or(1.0)),
             ("screw_zone_radius", self.screw_zone_radius),
             ("contact_zone_half_height", self.contact_zone_half_height),
             ("connector_stiffness", self.connector_stiffness),
@@ -343,12 +359,12 @@ impl Design {
         let rest = self.body_mass / steel - flange / steel - hub_area * hub_height_full;
         let mut hub_inner_radius = self.hub_inner_radius;
         let (mut inner_t, mut step_r) = (0.0, 0.0);
-        let (top_disk_thickness, rim_height) = match self.top_disk_thickness {
+        let (top_disk_thickness, rim_height) = match self.variant.top_disk_thickness {
             None => (rest / (disk_area - hub_area), 0.0),
-            Some(t) if self.rim_width == 0.0 => {
+            Some(t) if self.variant.rim_width == 0.0 => {
                 // The hub tube, under the disk's inner zone, takes the rest of the mass: its
                 // cross-section, hence its inner radius, follows.
-                (step_r, inner_t) = self.top_disk_inner.unwrap_or((self.hub_outer_radius, t));
+                (step_r, inner_t) = self.variant.top_disk_inner.unwrap_or((self.hub_outer_radius, t));
                 if !(inner_t > 0.0 && inner_t <= t && step_r >= self.hub_outer_radius && step_r < self.body_top_radius)
                 {
                     return Err(self.fail(format!(
@@ -369,11 +385,11 @@ impl Design {
                 (t, 0.0)
             }
             Some(t) => {
-                let inner = self.body_top_radius - self.rim_width;
-                if !(t > 0.0 && self.rim_width > 0.0 && inner > self.hub_outer_radius) {
+                let inner = self.body_top_radius - self.variant.rim_width;
+                if !(t > 0.0 && self.variant.rim_width > 0.0 && inner > self.hub_outer_radius) {
                     return Err(self.fail(format!(
                         "top_disk_thickness ({t} m) and rim_width ({} m) must be > 0, the rim outside the hub",
-                        self.rim_width
+                        self.variant.rim_width
                     )));
                 }
                 let rim = rest - (disk_area - hub_area) * t;
@@ -471,11 +487,11 @@ impl Design {
 
     /// Vertical size of a blade: its thickness if flat, its height if standing on edge.
     fn blade_vertical(&self) -> f64 {
-        self.blade_height.unwrap_or(self.blade_thickness)
+        self.variant.blade_height.unwrap_or(self.blade_thickness)
     }
 
     fn flange_radius(&self) -> f64 {
-        self.body_flange_radius.unwrap_or(self.envelope_ring_inner_radius)
+        self.variant.body_flange_radius.unwrap_or(self.envelope_ring_inner_radius)
     }
 
     fn sectors(&self) -> usize {
@@ -487,7 +503,7 @@ impl Design {
 
     fn blade_cells(&self) -> [usize; 3] {
         let along = ((self.blade_length / (0.5 * self.element_size)).ceil() as usize).max(8);
-        if let Some(h) = self.blade_height {
+        if let Some(h) = self.variant.blade_height {
             // On edge: one quadratic element through the thin plate, the height cut as the length.
             return [along, 1, ((h / (0.5 * self.element_size)).ceil() as usize).max(2)];
         }
@@ -550,7 +566,7 @@ impl Design {
             }
             profile.push(rect([ri, ro], [diaphragm_bottom, ring_top], "BODY"));
             profile.push(rect([ri, ro], [ring_top, disk_bottom], "BODY"));
-            let rim_inner = self.body_top_radius - self.rim_width;
+            let rim_inner = self.body_top_radius - self.variant.rim_width;
             if d.rim_height > 0.0 {
                 profile.push(rect(
                     [rim_inner, self.body_top_radius],
