@@ -88,7 +88,9 @@ fn time_integration_meets_the_harmonic_balance_on_reduced_harmony() {
         // balance sticks, dissipation where it slips.
         let friction: f64 = dissipated.iter().map(|&c| t[c]).sum();
         if k == 0 {
-            assert!(friction.abs() < 1e-12, "stuck point dissipates {friction} J");
+            // Round-off of the sums of force × slip increments: measured 5e-12 J (negative) with
+            // the 40 mm shaker insert, against more than 1e-3 J where the blades slip.
+            assert!(friction.abs() < 1e-9, "stuck point dissipates {friction} J");
         } else {
             assert!(friction > 1e-3, "slipping point dissipates only {friction} J");
         }

@@ -14,8 +14,16 @@
 //! - the blades are cantilevers from the top disk's rim to the envelope's inner wall, where the
 //!   contact holds their tip: their thickness (width from the blade mass) sets the stiffening when
 //!   stuck (paper: 237.6 Hz);
-//! - the shaker's coupling to the base plate (radius of the coupled zone) sets the second axial
-//!   mode, the assembly bouncing on the base plate's bending (paper: 878.4 Hz).
+//! - the shaker's coupling to the base plate (radius of the coupled zone, 40 mm) sets the
+//!   envelope substructure's first vertical mode on the shaker, the base plate and envelope
+//!   bouncing on the base plate's bending (Table 4: 880.4 Hz, test 889 Hz); in the assembly that
+//!   mode (~895 Hz) and the body's second axial mode (~854 Hz) are the pair near the paper's
+//!   second axial mode (878.4 Hz).
+//!
+//! The body substructure of Table 4 (synchronous axial mode 210.8 Hz, four asynchronous blade
+//! modes at 254-260 Hz) is not met by this design; the optional geometry of [`BodyVariant`]
+//! (a split flange, a thin, stepped or rimmed top disk, blades on edge) builds the variants that
+//! docs/harmony.md measures to show why.
 //!
 //! Modelling as Section 3.1: reference nodes rigidly drive the screw zones (radius 10 mm) on
 //! each blade and on the body, the blade tip face ("Top_Blade") and the envelope's contact zone
@@ -116,6 +124,9 @@ pub struct Design {
     pub hub_outer_radius: f64,
     pub hub_inner_radius: f64,
     pub diaphragm_thickness: f64,
+    /// Optional body geometry (the variants docs/harmony.md measures for Table 4); the default
+    /// is the design's. Boxed: a study keeps a `Design` by value.
+    pub variant: Box<BodyVariant>,
     /// Blade length (Table 1: 118 mm), mass (0.1086 kg), thickness; the width follows.
     pub blade_length: f64,
     pub blade_mass: f64,
@@ -131,7 +142,8 @@ pub struct Design {
     pub contact_vertical_stiffness: f64,
     pub shaker_mass: f64,
     pub shaker_spring: f64,
-    /// Radius of the base plate's bottom zone rigidly coupled to the shaker.
+    /// Radius of the base plate's bottom zone rigidly coupled to the shaker (the shaker's
+    /// armature insert).
     pub shaker_zone_radius: f64,
     pub steel_304l: Material,
     pub aluminium_2017a: Material,
@@ -156,6 +168,7 @@ impl Default for Design {
             hub_outer_radius: 0.060,
             hub_inner_radius: 0.054,
             diaphragm_thickness: 0.00431,
+            variant: Box::default(),
             blade_length: 0.118,
             blade_mass: 0.1086,
             blade_thickness: 0.0088,
@@ -166,10 +179,43 @@ impl Default for Design {
             contact_vertical_stiffness: 1e10,
             shaker_mass: 10.0,
             shaker_spring: 22800.0,
-            shaker_zone_radius: 0.100,
+            shaker_zone_radius: 0.040,
             steel_304l: Material { young: 193e9, poisson: 0.29, density: 7900.0 },
             aluminium_2017a: Material { young: 72.5e9, poisson: 0.33, density: 2790.0 },
             blade_steel: Material { young: 196e9, poisson: 0.272, density: 7780.0 },
+        }
+    }
+}
+
+/// Optional geometry of the body and blades, for the study of the body substructure (Table 4).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyVariant {
+    /// Outer radius of the body's flange: the diaphragm from the hub to this radius is the body's,
+    /// from it to the bottom ring the envelope's inner web (counted in the envelope's mass). The
+    /// body substructure is clamped on this circle. `None`: the whole diaphragm is the body's,
+    /// clamped at the bottom ring.
+    pub body_flange_radius: Option<f64>,
+    /// Top disk thickness; `None`: from the body mass. Given, the rest of the body mass is in a
+    /// rim ring under the disk's edge, `rim_width` wide, or, if `rim_width` is 0, in the hub tube
+    /// (its inner radius follows).
+    pub top_disk_thickness: Option<f64>,
+    pub rim_width: f64,
+    /// A thinner inner zone of the top disk (with `top_disk_thickness` given and no rim): its
+    /// outer radius and thickness; the hub stops under it.
+    pub top_disk_inner: Option<(f64, f64)>,
+    /// Blades standing on edge: a plate `blade_height` high (vertical), its thickness
+    /// (tangential) from the mass; `blade_thickness` is then not used. `None`: flat blades.
+    pub blade_height: Option<f64>,
+}
+
+impl Default for BodyVariant {
+    fn default() -> Self {
+        BodyVariant {
+            body_flange_radius: None,
+            top_disk_thickness: None,
+            rim_width: 0.02,
+            top_disk_inner: None,
+            blade_height: None,
         }
     }
 }
@@ -191,6 +237,12 @@ pub struct Dimensions {
     pub base_thickness: f64,
     pub envelope_inner_radius: f64,
     pub top_disk_thickness: f64,
+    /// Height of the rim ring under the top disk's edge (0: none).
+    pub rim_height: f64,
+    /// Thickness of the top disk's inner zone (= `top_disk_thickness` if none) and its radius.
+    pub top_disk_inner_thickness: f64,
+    pub top_disk_step_radius: f64,
+    pub hub_inner_radius: f64,
     pub blade_width: f64,
     pub masses: Vec<(&'static str, f64)>,
 }
@@ -226,6 +278,7 @@ impl Design {
             ("blade_length", self.blade_length),
             ("blade_mass", self.blade_mass),
             ("blade_thickness", self.blade_thickness),
+            ("blade_height", self.variant.blade_height.unwrap_or(1.0)),
             ("screw_zone_radius", self.screw_zone_radius),
             ("contact_zone_half_height", self.contact_zone_half_height),
             ("connector_stiffness", self.connector_stiffness),
@@ -264,11 +317,25 @@ impl Design {
         )?;
         let steel = self.steel_304l.density;
         let base_thickness = self.base_mass / (self.aluminium_2017a.density * PI * self.base_radius.powi(2));
-        // Envelope: the bottom ring, then a wall of the thickness that gives the mass.
+        // The diaphragm: the body's flange inside the flange radius, the envelope's web outside.
+        let diaphragm = steel
+            * PI
+            * (self.envelope_ring_inner_radius.powi(2) - self.hub_outer_radius.powi(2))
+            * self.diaphragm_thickness;
+        let flange_radius = self.flange_radius();
+        if !(flange_radius >= self.hub_outer_radius && flange_radius <= self.envelope_ring_inner_radius) {
+            return Err(self.fail(format!(
+                "body_flange_radius ({flange_radius} m) must lie between the hub's outer radius and the bottom ring's inner radius"
+            )));
+        }
+        let flange = steel * PI * (flange_radius.powi(2) - self.hub_outer_radius.powi(2)) * self.diaphragm_thickness;
+        let web = diaphragm - flange;
+        // Envelope: the bottom ring (and the web), then a wall of the thickness that gives the mass.
         let ring_mass = steel
             * PI
             * (self.envelope_radius.powi(2) - self.envelope_ring_inner_radius.powi(2))
-            * self.envelope_ring_height;
+            * self.envelope_ring_height
+            + web;
         let wall_height = self.envelope_height - self.envelope_ring_height;
         if ring_mass >= self.envelope_mass || wall_height <= 0.0 {
             return Err(self.fail(format!(
@@ -284,24 +351,58 @@ impl Design {
             )));
         }
         let envelope_inner_radius = inner2.sqrt();
-        // Body: diaphragm and hub tube, then a top disk of the thickness that gives the mass.
-        let diaphragm = steel
-            * PI
-            * (self.envelope_ring_inner_radius.powi(2) - self.hub_outer_radius.powi(2))
-            * self.diaphragm_thickness;
+        // Body: (diaphragm and) hub tube, then a top disk of the thickness that gives the mass,
+        // or of the given thickness with a rim ring carrying the rest.
         let hub_area = PI * (self.hub_outer_radius.powi(2) - self.hub_inner_radius.powi(2));
-        // top disk thickness t: mass = diaphragm + hub (height H - t - td... ) + disk.
         let disk_area = PI * self.body_top_radius.powi(2);
         let hub_height_full = self.body_height - self.diaphragm_thickness;
-        let rest = self.body_mass / steel - diaphragm / steel - hub_area * hub_height_full;
-        let top_disk_thickness = rest / (disk_area - hub_area);
-        if !(top_disk_thickness > 0.0 && top_disk_thickness < 0.5 * hub_height_full) {
+        let rest = self.body_mass / steel - flange / steel - hub_area * hub_height_full;
+        let mut hub_inner_radius = self.hub_inner_radius;
+        let (mut inner_t, mut step_r) = (0.0, 0.0);
+        let (top_disk_thickness, rim_height) = match self.variant.top_disk_thickness {
+            None => (rest / (disk_area - hub_area), 0.0),
+            Some(t) if self.variant.rim_width == 0.0 => {
+                // The hub tube, under the disk's inner zone, takes the rest of the mass: its
+                // cross-section, hence its inner radius, follows.
+                (step_r, inner_t) = self.variant.top_disk_inner.unwrap_or((self.hub_outer_radius, t));
+                if !(inner_t > 0.0 && inner_t <= t && step_r >= self.hub_outer_radius && step_r < self.body_top_radius)
+                {
+                    return Err(self.fail(format!(
+                        "top_disk_inner ({step_r} m, {inner_t} m): the inner zone must be thinner than the disk and outside the hub"
+                    )));
+                }
+                let full = PI * self.hub_outer_radius.powi(2);
+                let disk = PI * step_r.powi(2) * inner_t + PI * (self.body_top_radius.powi(2) - step_r.powi(2)) * t;
+                let hub = (self.body_mass / steel - flange / steel - disk) / (hub_height_full - inner_t);
+                let inner2 = (full - hub) / PI;
+                if !(inner2 > 0.0 && hub > 0.0) {
+                    return Err(self.fail(format!(
+                        "body_mass = {} kg cannot be met with a top disk {t} m thick and the hub's outer radius",
+                        self.body_mass
+                    )));
+                }
+                hub_inner_radius = inner2.sqrt();
+                (t, 0.0)
+            }
+            Some(t) => {
+                let inner = self.body_top_radius - self.variant.rim_width;
+                if !(t > 0.0 && self.variant.rim_width > 0.0 && inner > self.hub_outer_radius) {
+                    return Err(self.fail(format!(
+                        "top_disk_thickness ({t} m) and rim_width ({} m) must be > 0, the rim outside the hub",
+                        self.variant.rim_width
+                    )));
+                }
+                let rim = rest - (disk_area - hub_area) * t;
+                (t, rim / (PI * (self.body_top_radius.powi(2) - inner.powi(2))))
+            }
+        };
+        if !(top_disk_thickness > 0.0 && rim_height >= 0.0 && top_disk_thickness + rim_height < 0.5 * hub_height_full) {
             return Err(self.fail(format!(
-                "body_mass = {} kg cannot be met with these body dimensions (top disk thickness {top_disk_thickness:.4} m)",
+                "body_mass = {} kg cannot be met with these body dimensions (top disk thickness {top_disk_thickness:.4} m, rim height {rim_height:.4} m)",
                 self.body_mass
             )));
         }
-        let blade_width = self.blade_mass / (self.blade_steel.density * self.blade_length * self.blade_thickness);
+        let blade_width = self.blade_mass / (self.blade_steel.density * self.blade_length * self.blade_vertical());
         // The blade runs from the envelope wall inwards, over the top disk, where it is screwed.
         let blade_root = envelope_inner_radius - self.blade_length;
         let free_span = envelope_inner_radius - self.body_top_radius;
@@ -322,7 +423,7 @@ impl Design {
         if blade_width >= 2.0 * self.body_top_radius * (PI / 4.0).sin() {
             return Err(self.fail(format!("blades {blade_width:.4} m wide overlap on the top disk")));
         }
-        if self.blade_thickness + self.body_height + self.envelope_ring_height - self.diaphragm_thickness
+        if self.blade_vertical() + self.body_height + self.envelope_ring_height - self.diaphragm_thickness
             >= self.envelope_height
         {
             return Err(self.fail("the blades stand above the envelope's top".into()));
@@ -333,7 +434,20 @@ impl Design {
             ("central body", self.body_mass),
             ("blade", self.blade_mass),
         ];
-        Ok(Dimensions { base_thickness, envelope_inner_radius, top_disk_thickness, blade_width, masses })
+        if inner_t == 0.0 {
+            (inner_t, step_r) = (top_disk_thickness, self.hub_outer_radius);
+        }
+        Ok(Dimensions {
+            base_thickness,
+            envelope_inner_radius,
+            top_disk_thickness,
+            rim_height,
+            top_disk_inner_thickness: inner_t,
+            top_disk_step_radius: step_r,
+            hub_inner_radius,
+            blade_width,
+            masses,
+        })
     }
 
     /// Heights of the stack (m): base top, ring top, diaphragm bottom, hub top (top disk
@@ -343,14 +457,14 @@ impl Design {
         let ring_top = base_top + self.envelope_ring_height;
         let diaphragm_bottom = ring_top - self.diaphragm_thickness;
         let disk_top = diaphragm_bottom + self.body_height;
-        let disk_bottom = disk_top - d.top_disk_thickness;
+        let disk_bottom = disk_top - d.top_disk_inner_thickness;
         [
             base_top,
             ring_top,
             diaphragm_bottom,
             disk_bottom,
             disk_top,
-            disk_top + self.blade_thickness,
+            disk_top + self.blade_vertical(),
             base_top + self.envelope_height,
         ]
     }
@@ -371,6 +485,15 @@ impl Design {
         Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors + 4.0 * 3.0 * blade_cells * 4.0) as usize)
     }
 
+    /// Vertical size of a blade: its thickness if flat, its height if standing on edge.
+    fn blade_vertical(&self) -> f64 {
+        self.variant.blade_height.unwrap_or(self.blade_thickness)
+    }
+
+    fn flange_radius(&self) -> f64 {
+        self.variant.body_flange_radius.unwrap_or(self.envelope_ring_inner_radius)
+    }
+
     fn sectors(&self) -> usize {
         // A multiple of 8 so that the blades' planes (0, 90, 180, 270 degrees) and the
         // accelerometers at 45 degrees fall on node lines.
@@ -380,6 +503,10 @@ impl Design {
 
     fn blade_cells(&self) -> [usize; 3] {
         let along = ((self.blade_length / (0.5 * self.element_size)).ceil() as usize).max(8);
+        if let Some(h) = self.variant.blade_height {
+            // On edge: one quadratic element through the thin plate, the height cut as the length.
+            return [along, 1, ((h / (0.5 * self.element_size)).ceil() as usize).max(2)];
+        }
         let across = ((0.03 / self.element_size).ceil() as usize).max(2);
         [along, across, 1 + (self.element_size < 0.01) as usize]
     }
@@ -411,7 +538,7 @@ impl Design {
             ));
             // The wall, cut at the blades' heights so that the contact zones have nodes there.
             let zc = 0.5 * (disk_top + blade_top);
-            let cuts = [
+            let mut cuts = [
                 ring_top,
                 zc - self.contact_zone_half_height,
                 disk_top,
@@ -419,19 +546,40 @@ impl Design {
                 zc + self.contact_zone_half_height,
                 envelope_top,
             ];
+            cuts.sort_by(f64::total_cmp);
             for w in cuts.windows(2) {
                 if w[1] > w[0] + tol {
                     profile.push(rect([d.envelope_inner_radius, self.envelope_radius], [w[0], w[1]], "ENVELOPE"));
                 }
             }
         }
+        let flange_radius = self.flange_radius();
+        let has_web = flange_radius < self.envelope_ring_inner_radius - tol;
+        if has_web && with_envelope {
+            let r = [flange_radius, self.envelope_ring_inner_radius];
+            profile.push(rect(r, [diaphragm_bottom, ring_top], "ENVELOPE"));
+        }
         if with_body {
-            let (ri, ro) = (self.hub_inner_radius, self.hub_outer_radius);
-            profile.push(rect([ro, self.envelope_ring_inner_radius], [diaphragm_bottom, ring_top], "BODY"));
+            let (ri, ro) = (d.hub_inner_radius, self.hub_outer_radius);
+            if flange_radius > ro + tol {
+                profile.push(rect([ro, flange_radius], [diaphragm_bottom, ring_top], "BODY"));
+            }
             profile.push(rect([ri, ro], [diaphragm_bottom, ring_top], "BODY"));
             profile.push(rect([ri, ro], [ring_top, disk_bottom], "BODY"));
+            let rim_inner = self.body_top_radius - self.variant.rim_width;
+            if d.rim_height > 0.0 {
+                profile.push(rect(
+                    [rim_inner, self.body_top_radius],
+                    [disk_bottom - d.rim_height, disk_bottom],
+                    "BODY",
+                ));
+            }
             // Top disk, cut at the screw zones so that each zone has a ring of nodes.
             let mut radii = vec![0.0, ri, ro];
+            if d.rim_height > 0.0 {
+                radii.push(rim_inner);
+            }
+            radii.push(d.top_disk_step_radius);
             for r in self.screw_radii {
                 radii.extend([r - self.screw_zone_radius, r, r + self.screw_zone_radius]);
             }
@@ -440,6 +588,10 @@ impl Design {
             radii.dedup_by(|a, b| (*a - *b).abs() <= tol);
             for w in radii.windows(2) {
                 profile.push(rect([w[0], w[1]], [disk_bottom, disk_top], "BODY"));
+                let outer_bottom = disk_top - d.top_disk_thickness;
+                if w[0] >= d.top_disk_step_radius - tol && outer_bottom < disk_bottom - tol {
+                    profile.push(rect([w[0], w[1]], [outer_bottom, disk_bottom], "BODY"));
+                }
             }
         }
         let mut revolved = Part::new("STRUCTURE", self.kind, tol)?;
@@ -456,7 +608,7 @@ impl Design {
                 let edges = [
                     [self.blade_length * c, self.blade_length * s, 0.0],
                     [-w * s, w * c, 0.0],
-                    [0.0, 0.0, self.blade_thickness],
+                    [0.0, 0.0, self.blade_vertical()],
                 ];
                 let mut part = Part::new(&format!("BLADE_{}", i + 1), self.kind, tol)?;
                 part.add_block(&placed_box(origin, edges, self.blade_cells(), "BLADES"))?;
@@ -658,10 +810,11 @@ impl Design {
                 mesh.fixed.push((shaker, dir));
             }
         } else {
-            // Body alone: the diaphragm's outer rim clamped (its seat in the envelope).
+            // Body alone: the body's flange clamped on its outer circle (its seat in the envelope).
             for &n in &structure {
                 let x = mesh.nodes[n].xyz;
-                if (x[0].hypot(x[1]) - self.envelope_ring_inner_radius).abs() < 1e-6 && x[2] <= ring_top + tol {
+                let clamped = (x[0].hypot(x[1]) - flange_radius).abs() < 1e-6 && x[2] <= ring_top + tol;
+                if clamped {
                     mesh.fixed.extend((1..=3).map(|dir| (n, dir)));
                 }
             }

@@ -1,10 +1,11 @@
 //! The generated Harmony-like assembly against the paper's figures (Tables 1, 3-5), at the
 //! coarse refinement that CI affords (element size 60 mm, ~31k DOFs). The default refinement
-//! (30 mm, ~66k DOFs) is calibrated to the paper; docs/harmony.md gives the mesh convergence.
+//! (30 mm, ~66k DOFs) is calibrated to the paper; docs/harmony.md gives the mesh convergence and
+//! the substructures of Table 4.
 
 use stickslip_fe::assembly::FeModel;
 use stickslip_fe::eigen::{solve, to_sparse, EigenOptions};
-use stickslip_fe::harmony::{self, Configuration, Design};
+use stickslip_fe::harmony::{self, BodyVariant, Configuration, Design};
 use stickslip_fe::mesh::structured::GenerateError;
 
 /// Frequencies (Hz) of the axial modes among the lowest `count`: those where the top of the
@@ -44,6 +45,91 @@ fn coarse_assembly_has_the_paper_axial_modes_and_masses() {
     let (slipping, _) = axial_modes(&released, 6);
     assert!((slipping[0] / 190.0 - 1.0).abs() < 0.06, "all-slipping axial mode {} Hz", slipping[0]);
     assert!(slipping[0] < 0.9 * stuck[0]);
+}
+
+/// Modes of a configuration: frequencies (Hz) and the mass-normalised shapes' vertical motion at
+/// the given nodes, mode by mode.
+fn modes(design: &Design, config: Configuration, count: usize, nodes: &[u64]) -> (Vec<f64>, Vec<Vec<f64>>, f64) {
+    let fe = FeModel::assemble(design.build(config).expect("a buildable design")).expect("assembly");
+    let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
+    let (k, m) = (k.into_owned(), m.into_owned());
+    let sol = solve(&k, &m, &EigenOptions { count, ..Default::default() }).expect("modes");
+    let dofs: Vec<usize> = nodes.iter().map(|&n| fe.dof(n, 3).expect("node")).collect();
+    let z = (0..count).map(|j| dofs.iter().map(|&i| sol.modes.shapes[(i, j)]).collect()).collect();
+    (sol.modes.frequencies_hz(), z, fe.solid_mass)
+}
+
+/// The coarse design with an optional body geometry.
+fn variant(v: BodyVariant) -> Design {
+    Design { variant: Box::new(v), ..Design::refined(0.5) }
+}
+
+#[test]
+fn coarse_envelope_substructure_has_the_paper_first_vertical_mode() {
+    // Table 4: the envelope's first vertical mode, 880.4 Hz (test 889 Hz). Base plate and
+    // envelope on the shaker, coupled to it within 40 mm of the axis: the two bounce on the base
+    // plate's bending. Measured 889.7 Hz here, 889.4 Hz at the default refinement (+1.0 %); 3 %
+    // leaves room for the mesh, not for a change of the coupled zone (35 mm: 826 Hz, 45 mm:
+    // 927 Hz at the default refinement).
+    let nodes = [harmony::accelerometer(1), harmony::accelerometer(2), harmony::accelerometer(3)];
+    let (f, z, mass) = modes(&Design::refined(0.5), Configuration::Envelope, 14, &nodes);
+    assert!((mass - (9.47 + 44.88)).abs() < 5e-3 * 54.35, "base plate + envelope {mass} kg");
+    // Vertical: the base centre moves, the envelope top moves alike at 45 and 135 degrees.
+    let largest = z.iter().skip(1).map(|v| v[0].abs()).fold(0.0, f64::max);
+    let first = (1..f.len())
+        .find(|&j| z[j][0].abs() > 0.1 * largest && (z[j][1] - z[j][2]).abs() < 0.05 * z[j][1].abs())
+        .expect("a vertical mode");
+    assert!((f[first] / 880.4 - 1.0).abs() < 0.03, "envelope's first vertical mode {} Hz", f[first]);
+}
+
+#[test]
+fn upright_blades_give_four_asynchronous_blade_modes_in_the_body_substructure() {
+    // The variant of docs/harmony.md (not the default): Table 1's blade as a 65 mm high,
+    // 118 mm long plate standing on edge (1.82 mm thick from its mass). Clamped body, free tips:
+    // the blades' four tangential bending modes lie within 3 % of each other (paper: four modes
+    // at 254-260 Hz; here ~285 Hz with the default screws), between the body's synchronous
+    // axial mode and the top disk's modes.
+    let design = variant(BodyVariant { blade_height: Some(0.065), ..Default::default() });
+    let d = design.dimensions().unwrap();
+    assert!((d.blade_width - 1.82e-3).abs() < 0.02e-3, "blade thickness {} m", d.blade_width);
+    let (f, z, mass) = modes(&design, Configuration::BodyWithBlades, 10, &[harmony::accelerometer(0)]);
+    // 12.43 kg (+0.6 %, as the default design's body: the quadratic arcs and the diaphragm's
+    // ring under the hub, counted once in the thickness from the mass).
+    assert!((mass - (11.92 + 4.0 * 0.1086)).abs() < 1e-2 * 12.35, "body + blades {mass} kg");
+    // The body top does not move in the blade modes; the four nearest modes above the
+    // synchronous one are the blades'.
+    let sync = (0..f.len()).find(|&j| z[j][0].abs() > 0.1).expect("the synchronous axial mode");
+    let blades = &f[sync + 1..sync + 5];
+    assert!(blades.iter().all(|&b| (b / blades[0] - 1.0).abs() < 0.03), "blade modes {blades:?} Hz");
+    assert!((z[sync + 1..sync + 5]).iter().all(|v| v[0].abs() < 0.01));
+}
+
+#[test]
+fn optional_body_geometry_keeps_table_1_masses() {
+    // The variants docs/harmony.md measures for Table 4: the body's flange clamped on a circle
+    // inside the envelope's web, a thin or stepped top disk, a rim, blades on edge.
+    let variants = [
+        BodyVariant { body_flange_radius: Some(0.13), ..Default::default() },
+        BodyVariant { top_disk_thickness: Some(0.0037), rim_width: 0.0, ..Default::default() },
+        BodyVariant {
+            top_disk_thickness: Some(0.0045),
+            rim_width: 0.0,
+            top_disk_inner: Some((0.10, 0.0035)),
+            body_flange_radius: Some(0.13),
+            ..Default::default()
+        },
+        BodyVariant { top_disk_thickness: Some(0.004), rim_width: 0.02, ..Default::default() },
+        BodyVariant { blade_height: Some(0.065), ..Default::default() },
+    ]
+    .map(variant);
+    let table1 = 9.47 + 44.88 + 11.92 + 4.0 * 0.1086;
+    for design in variants {
+        let fe = FeModel::assemble(design.build(Configuration::Assembly).unwrap()).unwrap();
+        assert!((fe.solid_mass - table1).abs() < 5e-3 * table1, "{design:?}: {} kg", fe.solid_mass);
+        for config in [Configuration::Envelope, Configuration::BodyWithBlades] {
+            assert!(design.build(config).is_ok());
+        }
+    }
 }
 
 #[test]
