@@ -7,7 +7,7 @@ use faer::linalg::solvers::Solve;
 use faer::Mat;
 use stickslip_core::continuation::{Options, Silent, TerminationReason};
 use stickslip_core::elements::{Contact, Element, Jenkins};
-use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings, Jacobians};
+use stickslip_core::hbm::{stability_at, sweep_frequency, CondensedHbm, HbmSettings, Hill, HillSettings, Jacobians};
 use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel,
 };
@@ -197,10 +197,10 @@ fn newton_iteration_contact_seconds(c: usize, harmonics: usize, runs: usize) -> 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "quick");
-    // Optional filters: `table6`, `paper`, `cost`, `contact` (default: all).
+    // Optional filters: `table6`, `paper`, `cost`, `contact`, `stability` (default: all).
     let wanted = |name: &str| {
         let filters: Vec<&String> =
-            args.iter().filter(|a| ["table6", "paper", "cost", "contact"].contains(&a.as_str())).collect();
+            args.iter().filter(|a| ["table6", "paper", "cost", "contact", "stability"].contains(&a.as_str())).collect();
         filters.is_empty() || filters.iter().any(|f| *f == name)
     };
     let runs = if quick { 3 } else { 11 };
@@ -227,6 +227,39 @@ fn main() {
             print_sweep(&format!("137 DOFs, q = 4, {level} N, 170-300 Hz"), &f);
         }
         println!("{:<44} {:>9.3} ms for the 6 levels", "137 DOFs, q = 4, all levels", total * 1e3);
+    }
+    if wanted("stability") {
+        // Hill's method on every point of a paper-size sweep (2910 N, where the joints slip):
+        // the sweep alone, then the stability of each of its points (one evaluation of the
+        // joints' Jacobian and the Hill eigenproblem, with the sliders' memory refined).
+        let paper = chain_with_joints(137, 4, false);
+        let mut force = vec![0.0; 137];
+        force[136] = 1.0;
+        let mut hbm = CondensedHbm::new(&paper, &force, HbmSettings { harmonics: 7, samples: 300 }).unwrap();
+        let start = Instant::now();
+        let branch = sweep_frequency(&mut hbm, 2910.0, TWO_PI * 170.0, TWO_PI * 300.0, &options, &mut Silent).unwrap();
+        let sweep_seconds = start.elapsed().as_secs_f64();
+        let hill = Hill::new(hbm.receptance(), HillSettings::for_band(7, TWO_PI * 300.0)).unwrap();
+        let mut per_point = Vec::new();
+        let mut unstable = 0;
+        for p in branch.points.iter().step_by((branch.points.len() / 20).max(1)) {
+            let start = Instant::now();
+            let s = stability_at(&mut hbm, &hill, &p.x, p.lambda).unwrap();
+            per_point.push(start.elapsed().as_secs_f64());
+            unstable += usize::from(!s.is_stable(1e-9 * p.lambda));
+        }
+        let point = median(per_point.clone());
+        println!(
+            "137 DOFs, q = 4, 2910 N: sweep {:.1} ms for {} points; stability {:.1} ms/point with {} modes kept \
+             ({} of {} sampled points unstable): {:.0}x the sweep's cost per point",
+            sweep_seconds * 1e3,
+            branch.points.len(),
+            point * 1e3,
+            hill.n_modes(),
+            unstable,
+            per_point.len(),
+            point / (sweep_seconds / branch.points.len() as f64)
+        );
     }
     if wanted("contact") {
         println!("cost of one Newton iteration with 3-D contacts (residual + Jacobian | LU), 300 samples:");

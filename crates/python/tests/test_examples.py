@@ -16,7 +16,7 @@ import stickslip
 
 # The Harmony example (66k DOFs at refinement 1.0) runs at the coarse refinement 0.5 (~31k
 # DOFs), as the Rust end-to-end test does, to keep the suite's time reasonable.
-EXAMPLES = ["jenkins-1dof", "jenkins-2dof", "blade-joint", "harmony"]
+EXAMPLES = ["jenkins-1dof", "jenkins-2dof", "blade-joint", "harmony", "duffing"]
 
 
 def study_text(root, name):
