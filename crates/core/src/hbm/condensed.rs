@@ -23,6 +23,7 @@ use faer::{c64, Mat, MatMut};
 
 use super::element_aft::{AftError, ElementAft};
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
+use super::joint_forces::JointForces;
 use super::receptance::{HarmonicReceptance, Receptance};
 use crate::model::{ModelError, NonlinearModel};
 
@@ -65,17 +66,9 @@ pub struct CondensedHbm<'m> {
     receptance: Receptance,
     force: Vec<f64>,
     q: usize,
-    /// First global direction of each element.
-    offsets: Vec<usize>,
-    afts: Vec<ElementAft>,
+    /// The nonlinear part: the joints' forces by AFT.
+    joints: JointForces,
     harmonic: Vec<HarmonicReceptance>,
-    // Work buffers (no allocation per evaluation).
-    g: Vec<f64>,
-    dg_domega: Vec<f64>,
-    elem_u: Vec<Vec<f64>>,
-    elem_g: Vec<Vec<f64>>,
-    elem_jac: Vec<Mat<f64>>,
-    elem_dgdw: Vec<Vec<f64>>,
     h0: Mat<f64>,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
@@ -95,15 +88,7 @@ impl<'m> CondensedHbm<'m> {
         let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
         let receptance = Receptance::new(&model.linear, &directions, force)?;
         let q = directions.len();
-        let nc = plan.n_coeffs();
-        let mut offsets = Vec::with_capacity(model.elements.len());
-        let mut off = 0;
-        for e in &model.elements {
-            offsets.push(off);
-            off += e.law.n_dirs();
-        }
-        let afts = model.elements.iter().map(|e| ElementAft::new(e.law.as_ref(), &plan)).collect();
-        let dims: Vec<usize> = model.elements.iter().map(|e| e.law.n_dirs() * nc).collect();
+        let joints = JointForces::new(model, &plan);
         // Static receptance H(0) = Vᵀ K⁻¹ V (real).
         let mut h = HarmonicReceptance::new(q);
         receptance.evaluate(0.0, &mut h);
@@ -113,15 +98,8 @@ impl<'m> CondensedHbm<'m> {
             receptance,
             force: force.to_vec(),
             q,
-            offsets,
-            afts,
+            joints,
             harmonic: (0..settings.harmonics).map(|_| HarmonicReceptance::new(q)).collect(),
-            g: vec![0.0; q * nc],
-            dg_domega: vec![0.0; q * nc],
-            elem_u: dims.iter().map(|&m| vec![0.0; m]).collect(),
-            elem_g: dims.iter().map(|&m| vec![0.0; m]).collect(),
-            elem_jac: dims.iter().map(|&m| Mat::zeros(m, m)).collect(),
-            elem_dgdw: dims.iter().map(|&m| vec![0.0; m]).collect(),
             h0,
             plan,
             evaluations: 0,
@@ -204,7 +182,7 @@ impl<'m> CondensedHbm<'m> {
         for i in 0..q {
             let mut r = x[i];
             for j in 0..q {
-                r += self.h0[(i, j)] * self.g[j];
+                r += self.h0[(i, j)] * self.joints.g[j];
             }
             residual[i] = r;
         }
@@ -220,8 +198,8 @@ impl<'m> CondensedHbm<'m> {
                 }
                 for j in 0..q {
                     let h = hr.h[(i, j)];
-                    rc += h.re * self.g[ic + j] + h.im * self.g[is + j];
-                    rs += -h.im * self.g[ic + j] + h.re * self.g[is + j];
+                    rc += h.re * self.joints.g[ic + j] + h.im * self.joints.g[is + j];
+                    rs += -h.im * self.joints.g[ic + j] + h.re * self.joints.g[is + j];
                 }
                 residual[ic + i] = rc;
                 residual[is + i] = rs;
@@ -245,8 +223,8 @@ impl<'m> CondensedHbm<'m> {
         }
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
-            let off = self.offsets[e];
-            let je = &self.elem_jac[e];
+            let off = self.joints.offsets[e];
+            let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
                 for b in 0..d {
                     let col = c2 * q + off + b;
@@ -281,7 +259,7 @@ impl<'m> CondensedHbm<'m> {
         // ∂R/∂Ω = −λ_F ∂u_F/∂Ω + ∂H/∂Ω G + H ∂G/∂Ω, with ∂H_k/∂Ω = k H'(kΩ).
         if let Some(dw) = domega {
             for i in 0..q {
-                dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.dg_domega[j]).sum();
+                dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.joints.dg_domega[j]).sum();
             }
             for k in 1..=self.plan.n_harmonics() {
                 let hr = &self.harmonic[k - 1];
@@ -297,8 +275,8 @@ impl<'m> CondensedHbm<'m> {
                     for j in 0..q {
                         let dh = hr.dh[(i, j)] * kf;
                         let h = hr.h[(i, j)];
-                        let (gc, gs) = (self.g[ic + j], self.g[is + j]);
-                        let (dgc, dgs) = (self.dg_domega[ic + j], self.dg_domega[is + j]);
+                        let (gc, gs) = (self.joints.g[ic + j], self.joints.g[is + j]);
+                        let (dgc, dgs) = (self.joints.dg_domega[ic + j], self.joints.dg_domega[is + j]);
                         vc += dh.re * gc + dh.im * gs + h.re * dgc + h.im * dgs;
                         vs += -dh.im * gc + dh.re * gs - h.im * dgc + h.re * dgs;
                     }
@@ -359,31 +337,9 @@ impl<'m> CondensedHbm<'m> {
     }
 
     /// AFT of every element (Eq. 15): `G(x)` and, if `want`, `∂G/∂Ω` and each element's block
-    /// of `∂G/∂x` (the matrix is block diagonal over elements and never assembled).
+    /// of `∂G/∂x` ([`JointForces`]).
     fn element_forces(&mut self, x: &[f64], omega: f64, want: bool) -> Result<(), HbmError> {
-        let q = self.q;
-        let nc = self.plan.n_coeffs();
-        for (e, site) in self.model.elements.iter().enumerate() {
-            let d = site.law.n_dirs();
-            let off = self.offsets[e];
-            for c in 0..nc {
-                for a in 0..d {
-                    self.elem_u[e][c * d + a] = x[c * q + off + a];
-                }
-            }
-            let jac = if want { Some((self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e][..])) } else { None };
-            self.afts[e].evaluate(site.law.as_ref(), &self.plan, omega, &self.elem_u[e], &mut self.elem_g[e], jac)?;
-            for c in 0..nc {
-                for a in 0..d {
-                    let row = c * q + off + a;
-                    self.g[row] = self.elem_g[e][c * d + a];
-                    if want {
-                        self.dg_domega[row] = self.elem_dgdw[e][c * d + a];
-                    }
-                }
-            }
-        }
-        Ok(())
+        Ok(self.joints.evaluate(self.model, &self.plan, x, omega, want)?)
     }
 
     /// `∂G/∂x` at `x` and Ω (q(2N+1) square, coefficient-major as the unknowns): the joints'
@@ -391,70 +347,35 @@ impl<'m> CondensedHbm<'m> {
     /// ([`super::stability`]).
     pub fn element_force_jacobian(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
         self.element_forces(x, omega, true)?;
-        let (q, nc) = (self.q, self.plan.n_coeffs());
-        let mut jac = Mat::zeros(q * nc, q * nc);
-        for (e, site) in self.model.elements.iter().enumerate() {
-            let (d, off, je) = (site.law.n_dirs(), self.offsets[e], &self.elem_jac[e]);
-            for c1 in 0..nc {
-                for a in 0..d {
-                    for c2 in 0..nc {
-                        for b in 0..d {
-                            jac[(c1 * q + off + a, c2 * q + off + b)] = je[(c1 * d + a, c2 * d + b)];
-                        }
-                    }
-                }
-            }
-        }
-        Ok(jac)
+        let jac = self.joints.assembled_jacobian(self.model, self.plan.n_coeffs(), |_, _| {});
+        Ok(Mat::from_fn(jac.nrows(), jac.ncols(), |i, j| jac[(i, j)].re))
     }
 
     /// `∂G/∂x` for a perturbation `e^{st} p(t)` of the solution at `x`, Ω (complex, same layout
     /// as [`Self::element_force_jacobian`]): the sliders' memory of their anchor weighted by
-    /// `e^{−sΔ}` ([`ElementAft::add_memory_delay`]). Returns also whether any element has such
-    /// a delay (if not, the matrix is the real `∂G/∂x`, whatever `s`).
-    pub fn element_force_jacobian_delayed(
-        &mut self,
-        x: &[f64],
-        omega: f64,
-        s: c64,
-    ) -> Result<(Mat<c64>, bool), HbmError> {
-        let real = self.element_force_jacobian(x, omega)?;
-        let (q, nc) = (self.q, self.plan.n_coeffs());
-        let mut jac = Mat::from_fn(q * nc, q * nc, |i, j| c64::new(real[(i, j)], 0.0));
-        let mut delayed = false;
-        for (e, site) in self.model.elements.iter().enumerate() {
-            let (d, off) = (site.law.n_dirs(), self.offsets[e]);
-            let mut block = Mat::from_fn(d * nc, d * nc, |i, j| c64::new(self.elem_jac[e][(i, j)], 0.0));
-            if self.afts[e].add_memory_delay(&self.plan, omega, s, &mut block) {
-                delayed = true;
-                for c1 in 0..nc {
-                    for a in 0..d {
-                        for c2 in 0..nc {
-                            for b in 0..d {
-                                jac[(c1 * q + off + a, c2 * q + off + b)] = block[(c1 * d + a, c2 * d + b)];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        Ok((jac, delayed))
+    /// `e^{−sΔ}` ([`ElementAft::add_memory_delay`]).
+    pub fn element_force_jacobian_delayed(&mut self, x: &[f64], omega: f64, s: c64) -> Result<Mat<c64>, HbmError> {
+        self.element_forces(x, omega, true)?;
+        let (afts, plan) = (&self.joints.afts, &self.plan);
+        Ok(self.joints.assembled_jacobian(self.model, plan.n_coeffs(), |e, block| {
+            afts[e].add_memory_delay(plan, omega, s, block);
+        }))
     }
 
     /// Did the last Jacobian include a slider's memory of its anchor, which a perturbation
     /// `e^{st}` delays ([`Self::element_force_jacobian_delayed`])?
     pub fn has_memory_delay(&self) -> bool {
-        self.afts.iter().any(|a| a.has_memory_delay())
+        self.joints.has_memory_delay()
     }
 
     /// The AFT state of element `e` after the last evaluation (time samples of u, v, g, slip).
     pub fn element_aft(&self, e: usize) -> &ElementAft {
-        &self.afts[e]
+        &self.joints.afts[e]
     }
 
     /// Harmonics of the element forces after the last evaluation (coefficient-major, q wide).
     pub fn element_force_harmonics(&self) -> &[f64] {
-        &self.g
+        &self.joints.g
     }
 }
 

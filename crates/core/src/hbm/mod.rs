@@ -4,6 +4,7 @@ pub mod condensed;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
+pub mod joint_forces;
 pub mod nonlinear_mode;
 pub mod receptance;
 pub mod stability;

@@ -53,8 +53,9 @@
 use faer::{c64, Mat, MatMut};
 
 use super::condensed::HbmSettings;
-use super::element_aft::{AftError, ElementAft};
+use super::element_aft::AftError;
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
+use super::joint_forces::JointForces;
 use crate::continuation::{
     continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError, Scales, TerminationReason,
 };
@@ -108,16 +109,10 @@ pub struct NonlinearMode<'m> {
     /// The condensed modes see `−ξ` too ([`NegativeDamping::MassProportional`]).
     shift_all: bool,
     q: usize,
-    offsets: Vec<usize>,
-    afts: Vec<ElementAft>,
+    /// The nonlinear part: the joints' forces by AFT.
+    joints: JointForces,
     // Work buffers, allocated once.
     u: Vec<f64>,
-    g: Vec<f64>,
-    dg_domega: Vec<f64>,
-    elem_u: Vec<Vec<f64>>,
-    elem_g: Vec<Vec<f64>>,
-    elem_jac: Vec<Mat<f64>>,
-    elem_dgdw: Vec<Vec<f64>>,
     /// `H_rest` per harmonic 0..=N and its derivatives in Ω (harmonic factor included) and ξ.
     h: Vec<Mat<c64>>,
     dh_domega: Vec<Mat<c64>>,
@@ -236,14 +231,7 @@ impl<'m> NonlinearMode<'m> {
             .collect();
         let target = settings.mode;
         let nc = plan.n_coeffs();
-        let mut offsets = Vec::with_capacity(model.elements.len());
-        let mut off = 0;
-        for e in &model.elements {
-            offsets.push(off);
-            off += e.law.n_dirs();
-        }
-        let afts = model.elements.iter().map(|e| ElementAft::new(e.law.as_ref(), &plan)).collect();
-        let dims: Vec<usize> = model.elements.iter().map(|e| e.law.n_dirs() * nc).collect();
+        let joints = JointForces::new(model, &plan);
         let nh = plan.n_harmonics();
         let zeros = || (0..=nh).map(|_| Mat::<c64>::zeros(q, q)).collect::<Vec<_>>();
         Ok(NonlinearMode {
@@ -258,15 +246,8 @@ impl<'m> NonlinearMode<'m> {
             shapes: modes.shapes,
             shift_all: settings.negative_damping == NegativeDamping::MassProportional,
             q,
-            offsets,
-            afts,
+            joints,
             u: vec![0.0; q * nc],
-            g: vec![0.0; q * nc],
-            dg_domega: vec![0.0; q * nc],
-            elem_u: dims.iter().map(|&d| vec![0.0; d]).collect(),
-            elem_g: dims.iter().map(|&d| vec![0.0; d]).collect(),
-            elem_jac: dims.iter().map(|&d| Mat::zeros(d, d)).collect(),
-            elem_dgdw: dims.iter().map(|&d| vec![0.0; d]).collect(),
             h: zeros(),
             dh_domega: zeros(),
             dh_dxi: zeros(),
@@ -341,30 +322,10 @@ impl<'m> NonlinearMode<'m> {
 
     /// AFT of every element at `u = a û` and Ω: G, and if `want`, each element's ∂G/∂u, ∂G/∂Ω.
     fn element_forces(&mut self, y: &[f64], amplitude: f64, omega: f64, want: bool) -> Result<(), AftError> {
-        let q = self.q;
-        let nc = self.plan.n_coeffs();
-        for i in 0..q * nc {
-            self.u[i] = amplitude * y[i];
+        for (u, v) in self.u.iter_mut().zip(y) {
+            *u = amplitude * v;
         }
-        for (e, site) in self.model.elements.iter().enumerate() {
-            let d = site.law.n_dirs();
-            let off = self.offsets[e];
-            for c in 0..nc {
-                for a in 0..d {
-                    self.elem_u[e][c * d + a] = self.u[c * q + off + a];
-                }
-            }
-            let jac = if want { Some((self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e][..])) } else { None };
-            self.afts[e].evaluate(site.law.as_ref(), &self.plan, omega, &self.elem_u[e], &mut self.elem_g[e], jac)?;
-            for c in 0..nc {
-                for a in 0..d {
-                    let row = c * q + off + a;
-                    self.g[row] = self.elem_g[e][c * d + a];
-                    self.dg_domega[row] = if want { self.elem_dgdw[e][c * d + a] } else { 0.0 };
-                }
-            }
-        }
-        Ok(())
+        self.joints.evaluate(self.model, &self.plan, &self.u, omega, want)
     }
 
     /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives (modal sum over every mode but the target).
@@ -426,9 +387,9 @@ impl<'m> NonlinearMode<'m> {
             let gk: Vec<c64> = (0..q)
                 .map(|i| {
                     if k == 0 {
-                        c64::new(self.g[i], 0.0)
+                        c64::new(self.joints.g[i], 0.0)
                     } else {
-                        c64::new(self.g[cos_index(k) * q + i], -self.g[sin_index(k) * q + i])
+                        c64::new(self.joints.g[cos_index(k) * q + i], -self.joints.g[sin_index(k) * q + i])
                     }
                 })
                 .collect();
@@ -460,20 +421,20 @@ impl<'m> NonlinearMode<'m> {
         let mut joint_energy = Vec::with_capacity(self.model.elements.len());
         let mut stick_fraction = Vec::with_capacity(self.model.elements.len());
         for (e, site) in self.model.elements.iter().enumerate() {
-            let off = self.offsets[e];
+            let off = self.joints.offsets[e];
             // ∮ g du = π Σ_k k (s_k g_ck − c_k g_sk), exact for the truncated motion.
             let w: f64 = (off..off + site.law.n_dirs())
                 .map(|i| {
                     (1..=nh)
                         .map(|k| {
                             let (ic, is) = (cos_index(k) * q + i, sin_index(k) * q + i);
-                            pi * k as f64 * (self.u[is] * self.g[ic] - self.u[ic] * self.g[is])
+                            pi * k as f64 * (self.u[is] * self.joints.g[ic] - self.u[ic] * self.joints.g[is])
                         })
                         .sum::<f64>()
                 })
                 .sum();
             joint_energy.push(w);
-            let aft = &self.afts[e];
+            let aft = &self.joints.afts[e];
             stick_fraction.push(aft.slipping.iter().filter(|s| !**s).count() as f64 / nt as f64);
         }
         let energy_per_cycle = viscous + joint_energy.iter().sum::<f64>();
@@ -543,7 +504,7 @@ impl Problem for NonlinearMode<'_> {
                 for i in 0..q {
                     let mut r = y[i] - self.a_t[i] * e0;
                     for j in 0..q {
-                        r += h[(i, j)].re * self.g[j] * inv_a;
+                        r += h[(i, j)].re * self.joints.g[j] * inv_a;
                     }
                     residual[i] = r;
                 }
@@ -555,7 +516,7 @@ impl Problem for NonlinearMode<'_> {
                 let mut rc = y[ic * q + i] - self.a_t[i] * ec;
                 let mut rs = y[is * q + i] - self.a_t[i] * es;
                 for j in 0..q {
-                    let (gc, gs) = (self.g[ic * q + j] * inv_a, self.g[is * q + j] * inv_a);
+                    let (gc, gs) = (self.joints.g[ic * q + j] * inv_a, self.joints.g[is * q + j] * inv_a);
                     rc += h[(i, j)].re * gc + h[(i, j)].im * gs;
                     rs += -h[(i, j)].im * gc + h[(i, j)].re * gs;
                 }
@@ -565,14 +526,14 @@ impl Problem for NonlinearMode<'_> {
         }
         // R_η (scaled by 1/(a ω_*²)): D_k η̂_k + a_*ᵀ G_k/(a ω_*²), D_k/ω_*² = 1 − (kw)² + i kw(c̃ − ξ̂).
         let proj = |g: &[f64], c: usize| -> f64 { (0..q).map(|i| self.a_t[i] * g[c * q + i]).sum::<f64>() };
-        residual[base] = self.eta(y, 0) + proj(&self.g, 0) * inv_a / w2;
+        residual[base] = self.eta(y, 0) + proj(&self.joints.g, 0) * inv_a / w2;
         for k in 1..=nh {
             let kw = k as f64 * w;
             let (zr, zi) = (1.0 - kw * kw, kw * (ct - xih));
             let (ic, is) = (cos_index(k), sin_index(k));
             let (ec, es) = (self.eta(y, ic), self.eta(y, is));
-            residual[base + ic] = zr * ec + zi * es + proj(&self.g, ic) * inv_a / w2;
-            residual[base + is] = -zi * ec + zr * es + proj(&self.g, is) * inv_a / w2;
+            residual[base + ic] = zr * ec + zi * es + proj(&self.joints.g, ic) * inv_a / w2;
+            residual[base + is] = -zi * ec + zr * es + proj(&self.joints.g, is) * inv_a / w2;
         }
         let Some((mut dy, dl)) = jacobian else { return Ok(()) };
 
@@ -580,12 +541,12 @@ impl Problem for NonlinearMode<'_> {
         // ∂G/∂u is block diagonal over elements; t = ∂G/∂u û − G/a is built on the way.
         for i in 0..base {
             dy[(i, i)] = 1.0;
-            self.t[i] = -self.g[i] * inv_a;
+            self.t[i] = -self.joints.g[i] * inv_a;
         }
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
-            let off = self.offsets[e];
-            let je = &self.elem_jac[e];
+            let off = self.joints.offsets[e];
+            let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
                 for b in 0..d {
                     let col = c2 * q + off + b;
@@ -649,7 +610,7 @@ impl Problem for NonlinearMode<'_> {
             let (h, dh, dx) = (&self.h[k], &self.dh_domega[k], &self.dh_dxi[k]);
             if k == 0 {
                 for i in 0..q {
-                    let v: f64 = (0..q).map(|j| h[(i, j)].re * self.dg_domega[j]).sum();
+                    let v: f64 = (0..q).map(|j| h[(i, j)].re * self.joints.dg_domega[j]).sum();
                     dy[(i, iw)] += wt * v * inv_a;
                 }
                 continue;
@@ -658,8 +619,9 @@ impl Problem for NonlinearMode<'_> {
             for i in 0..q {
                 let (mut wc, mut ws, mut xc, mut xs) = (0.0, 0.0, 0.0, 0.0);
                 for j in 0..q {
-                    let (gc, gs) = (self.g[ic * q + j] * inv_a, self.g[is * q + j] * inv_a);
-                    let (dgc, dgs) = (self.dg_domega[ic * q + j] * inv_a, self.dg_domega[is * q + j] * inv_a);
+                    let (gc, gs) = (self.joints.g[ic * q + j] * inv_a, self.joints.g[is * q + j] * inv_a);
+                    let (dgc, dgs) =
+                        (self.joints.dg_domega[ic * q + j] * inv_a, self.joints.dg_domega[is * q + j] * inv_a);
                     let (hh, dd, xx) = (h[(i, j)], dh[(i, j)], dx[(i, j)]);
                     wc += dd.re * gc + dd.im * gs + hh.re * dgc + hh.im * dgs;
                     ws += -dd.im * gc + dd.re * gs - hh.im * dgc + hh.re * dgs;
@@ -672,15 +634,15 @@ impl Problem for NonlinearMode<'_> {
                 dy[(is * q + i, iw + 1)] += wt * xs;
             }
         }
-        dy[(base, iw)] += wt * proj(&self.dg_domega, 0) * inv_a / w2;
+        dy[(base, iw)] += wt * proj(&self.joints.dg_domega, 0) * inv_a / w2;
         for k in 1..=nh {
             let kf = k as f64;
             let (ic, is) = (cos_index(k), sin_index(k));
             let (ec, es) = (self.eta(y, ic), self.eta(y, is));
             // d(D_k/ω_*²)/dw = −2k²w + i k (c̃ − ξ̂); d(D_k/ω_*²)/dξ̂ = −i k w.
             let (zr, zi) = (-2.0 * kf * kf * w, kf * (ct - xih));
-            dy[(base + ic, iw)] += zr * ec + zi * es + wt * proj(&self.dg_domega, ic) * inv_a / w2;
-            dy[(base + is, iw)] += -zi * ec + zr * es + wt * proj(&self.dg_domega, is) * inv_a / w2;
+            dy[(base + ic, iw)] += zr * ec + zi * es + wt * proj(&self.joints.dg_domega, ic) * inv_a / w2;
+            dy[(base + is, iw)] += -zi * ec + zr * es + wt * proj(&self.joints.dg_domega, is) * inv_a / w2;
             let zi = -kf * w;
             dy[(base + ic, iw + 1)] += zi * es;
             dy[(base + is, iw + 1)] += -zi * ec;
