@@ -1,31 +1,15 @@
 //! A Duffing oscillator through the harmonic balance and the continuation: the fold of the
 //! hardening peak is passed, and the branch matches the first-order closed form.
-use faer::Mat;
+mod duffing_common;
+
+use duffing_common::{duffing, C, F, K, K3, M};
 use stickslip_core::continuation::{Options, Silent, TerminationReason};
-use stickslip_core::elements::{CubicSpring, Element};
 use stickslip_core::hbm::fourier::{cos_index, sin_index};
 use stickslip_core::hbm::{sweep_frequency, CondensedHbm, HbmSettings};
-use stickslip_core::model::{Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel};
-
-const M: f64 = 1.0;
-const K: f64 = 1.0e4;
-const C: f64 = 2.0; // ζ = 0.01
-const K3: f64 = 1.0e7;
-const F: f64 = 5.0;
 
 #[test]
 fn duffing_fold_is_passed_and_the_branch_matches_the_closed_form_and_backbone() {
-    let linear = LinearModel::new(
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| M)),
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| K)),
-        Damping::Rayleigh { alpha: C / M, beta: 0.0 },
-        vec![DofLabel::named("x")],
-        vec![],
-    )
-    .unwrap();
-    let law: Box<dyn Element> = Box::new(CubicSpring::new(K3).unwrap());
-    let model =
-        NonlinearModel::new(linear, vec![ElementSite { name: "k3".into(), law, directions: vec![vec![1.0]] }]).unwrap();
+    let model = duffing();
     // N = 1 and 16 samples: u³ has harmonics 1 and 3 only, which 16 samples separate exactly,
     // so this is the first-order balance whose closed form is below.
     let mut hbm = CondensedHbm::new(&model, &[1.0], HbmSettings { harmonics: 1, samples: 16 }).unwrap();

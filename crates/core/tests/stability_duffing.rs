@@ -1,34 +1,17 @@
 //! Hill's method on a Duffing oscillator: the middle branch between the folds is unstable, and
 //! the Floquet multipliers equal those of the monodromy matrix integrated in time.
+mod duffing_common;
+
+use duffing_common::{duffing, C, F, K, K3, M};
 use faer::{c64, Mat};
 use stickslip_core::continuation::{zero_along, Options, Silent, TerminationReason};
-use stickslip_core::elements::{CubicSpring, Element};
 use stickslip_core::hbm::fourier::{cos_index, sin_index};
 use stickslip_core::hbm::{
     bifurcations, stability_at, sweep_frequency, BifurcationKind, CondensedHbm, FrequencySweep, HbmSettings, Hill,
     HillSettings, Jacobians,
 };
-use stickslip_core::model::{Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel};
 
-const M: f64 = 1.0;
-const K: f64 = 1.0e4;
-const C: f64 = 2.0; // ζ = 0.01
-const K3: f64 = 1.0e7;
-const F: f64 = 5.0;
 const HARMONICS: usize = 7;
-
-fn duffing() -> NonlinearModel {
-    let linear = LinearModel::new(
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| M)),
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| K)),
-        Damping::Rayleigh { alpha: C / M, beta: 0.0 },
-        vec![DofLabel::named("x")],
-        vec![],
-    )
-    .unwrap();
-    let law: Box<dyn Element> = Box::new(CubicSpring::new(K3).unwrap());
-    NonlinearModel::new(linear, vec![ElementSite { name: "k3".into(), law, directions: vec![vec![1.0]] }]).unwrap()
-}
 
 /// x(t) from the harmonics (1 DOF, coefficient-major).
 fn displacement(x: &[f64], omega: f64, t: f64) -> f64 {

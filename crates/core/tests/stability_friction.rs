@@ -4,31 +4,17 @@ mod timesim_common;
 
 use faer::Mat;
 use stickslip_core::continuation::{Options, Silent, TerminationReason};
-use stickslip_core::elements::Jenkins;
 use stickslip_core::hbm::{stability_at, sweep_level, CondensedHbm, HbmSettings, Hill, HillSettings};
-use stickslip_core::model::{Damping, DofLabel, ElementSite, LinearModel, Matrix, NonlinearModel};
+use stickslip_core::model::{Damping, NonlinearModel};
 use stickslip_core::timesim::{Integrator, Scheme, State};
-use timesim_common::{DAMPING, F_COULOMB, K_JENKINS, K_TOTAL, MASS};
+use timesim_common::{table6_with, DAMPING, MASS};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
 /// Table 6 with its damping written as α M (the same 350 N·s/m), the modal form Hill's method
 /// needs.
 fn table6_modal() -> NonlinearModel {
-    let linear = LinearModel::new(
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| MASS)),
-        Matrix::Dense(Mat::from_fn(1, 1, |_, _| K_TOTAL)),
-        Damping::Rayleigh { alpha: DAMPING / MASS, beta: 0.0 },
-        vec![DofLabel::named("x")],
-        vec![],
-    )
-    .unwrap();
-    let law = Jenkins::replacing_stiffness(K_JENKINS, F_COULOMB).unwrap();
-    NonlinearModel::new(
-        linear,
-        vec![ElementSite { name: "joint".into(), law: Box::new(law), directions: vec![vec![1.0]] }],
-    )
-    .unwrap()
+    table6_with(Damping::Rayleigh { alpha: DAMPING / MASS, beta: 0.0 })
 }
 
 /// Decay rate (1/s) of small perturbations of the steady state at `frequency_hz`, `level` (N),

@@ -17,10 +17,15 @@ pub const F_EXCIT: f64 = 1000.0;
 /// The Table 6 1-DOF model in the paper's form (Eq. 11): K holds the total stuck stiffness
 /// and the Jenkins element replaces its part `k_jenkins`.
 pub fn table6() -> NonlinearModel {
+    table6_with(Damping::Matrix(Matrix::Dense(Mat::from_fn(1, 1, |_, _| DAMPING))))
+}
+
+/// Table 6 with its damping written as `damping` (e.g. α M, the same 350 N·s/m in modal form).
+pub fn table6_with(damping: Damping) -> NonlinearModel {
     let linear = LinearModel::new(
         Matrix::Dense(Mat::from_fn(1, 1, |_, _| MASS)),
         Matrix::Dense(Mat::from_fn(1, 1, |_, _| K_TOTAL)),
-        Damping::Matrix(Matrix::Dense(Mat::from_fn(1, 1, |_, _| DAMPING))),
+        damping,
         vec![DofLabel::named("x")],
         vec![],
     )
