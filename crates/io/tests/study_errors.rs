@@ -222,3 +222,13 @@ fn a_snapshot_needs_a_positive_frequency_and_level() {
     let snapshots = study.unwrap().snapshots;
     assert_eq!((snapshots.len(), snapshots[0].frequency_hz, snapshots[0].level), (1, 238.0, 3420.0));
 }
+
+#[test]
+fn stability_with_a_damping_matrix_names_the_key_and_what_hill_needs() {
+    let text = broken("alpha = 2.0", "matrix = [[2.0, 0.0], [0.0, 1.0]]") + "\n[harmonic_balance]\nstability = true\n";
+    let e = parse_error(&text);
+    assert!(e.contains("study.toml:") && e.contains("stability = true needs damping that is diagonal"), "{e}");
+    // The same study with α M is accepted.
+    let ok = GOOD.to_string() + "\n[harmonic_balance]\nstability = true\n";
+    assert!(Study::parse(&ok, "study.toml").unwrap().hbm.stability);
+}
