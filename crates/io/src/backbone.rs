@@ -76,3 +76,63 @@ pub fn write_backbone_csv(
     }
     std::fs::write(path, text).map_err(|source| OutputError::Io { path: path.to_path_buf(), source })
 }
+
+/// The forced response of one level synthesised from a backbone.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SingleModeFrf {
+    /// Force level (N).
+    pub level_n: f64,
+    /// `(frequency (Hz), |X₁|/F (m/N) at each output)` along the curve.
+    pub points: Vec<(f64, Vec<f64>)>,
+}
+
+/// The forced response of each level synthesised from the backbone alone (single nonlinear
+/// mode theory, [`Backbone::single_mode_response`]).
+pub fn single_mode_frfs(backbone: &Backbone, load: &[f64], levels_n: &[f64]) -> Vec<SingleModeFrf> {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    levels_n
+        .iter()
+        .map(|&level| {
+            let curve = backbone
+                .single_mode_response(load, level)
+                .iter()
+                .map(|s| {
+                    let p = &backbone.points[s.point];
+                    let frfs = (0..p.outputs.len()).map(|o| p.output_amplitude(o, 1) / level).collect();
+                    (s.omega / two_pi, frfs)
+                })
+                .collect();
+            SingleModeFrf { level_n: level, points: curve }
+        })
+        .collect()
+}
+
+/// Write `single_mode_frf.csv`: `level_N,frequency_Hz` and `<output>_disp_frf_m_per_N` per
+/// output, the forced responses of [`single_mode_frfs`], one row per point of each curve.
+pub fn write_single_mode_csv(path: &Path, frfs: &[SingleModeFrf], outputs: &[String]) -> Result<(), OutputError> {
+    let mut text = String::from("level_N,frequency_Hz");
+    for o in outputs {
+        let _ = write!(text, ",{o}_disp_frf_m_per_N");
+    }
+    text.push('\n');
+    for SingleModeFrf { level_n: level, points } in frfs {
+        for (f, values) in points {
+            for v in std::iter::once(f).chain(values) {
+                if !v.is_finite() {
+                    return Err(OutputError::NotFinite {
+                        path: path.to_path_buf(),
+                        quantity: "the synthesised response".into(),
+                        location: format!("{level} N near {f} Hz"),
+                        value: *v,
+                    });
+                }
+            }
+            let _ = write!(text, "{level:e},{f:.10e}");
+            for v in values {
+                let _ = write!(text, ",{v:.10e}");
+            }
+            text.push('\n');
+        }
+    }
+    std::fs::write(path, text).map_err(|source| OutputError::Io { path: path.to_path_buf(), source })
+}

@@ -60,12 +60,12 @@ pub fn log_axis(lo: f64, hi: f64) -> Range<f64> {
     lo / 1.5..hi * 1.5
 }
 
-/// One curve: a label and its points, drawn dashed where `unstable` (per point; empty when
-/// every point is stable or stability is not known).
+/// One curve: a label and its points, drawn dashed where `dashed` is true (per point; empty
+/// for a solid curve): unstable stretches of a branch, or a prediction beside a computation.
 struct Curve {
     label: String,
     points: Vec<(f64, f64)>,
-    unstable: Vec<bool>,
+    dashed: Vec<bool>,
 }
 
 /// A labelled point drawn on a chart (a bifurcation).
@@ -187,7 +187,7 @@ impl Chart {
                 .points
                 .iter()
                 .enumerate()
-                .map(|(j, &p)| (p, c.unstable.get(j).copied().unwrap_or(false)))
+                .map(|(j, &p)| (p, c.dashed.get(j).copied().unwrap_or(false)))
                 .filter(|(p, _)| keep(p))
                 .collect();
             // Runs of equal stability, each sharing its first point with the previous run's
@@ -195,14 +195,14 @@ impl Chart {
             let mut start = 0;
             let mut labelled = false;
             while start < kept.len() || !labelled {
-                let unstable = kept.get(start).is_some_and(|k| k.1);
+                let dashed = kept.get(start).is_some_and(|k| k.1);
                 let mut end = start + 1;
-                while end < kept.len() && kept[end].1 == unstable {
+                while end < kept.len() && kept[end].1 == dashed {
                     end += 1;
                 }
                 let run: Vec<(f64, f64)> =
                     kept[start.saturating_sub(1)..end.min(kept.len())].iter().map(|k| k.0).collect();
-                let series = if unstable {
+                let series = if dashed {
                     chart.draw_series(DashedLineSeries::new(run, 8, 6, style))?
                 } else {
                     chart.draw_series(LineSeries::new(run, style))?
@@ -298,7 +298,7 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
         curves.push(Curve {
             label: format!("{} N", l.level_n),
             points,
-            unstable: l.points.iter().map(is_unstable).collect(),
+            dashed: l.points.iter().map(is_unstable).collect(),
         });
         for b in &l.bifurcations {
             if let Some((_, a)) = b.amplitudes.iter().find(|(name, _)| name == output) {
@@ -306,7 +306,7 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
             }
         }
     }
-    let any_unstable = curves.iter().any(|c| c.unstable.iter().any(|&u| u));
+    let any_unstable = curves.iter().any(|c| c.dashed.iter().any(|&u| u));
     Chart {
         title: format!(
             "FRF of {output} (displacement |X₁|/F, one curve per level{})",
@@ -360,7 +360,7 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
         .map(|k| Curve {
             label: format!("harmonic {k}"),
             points: level.points.iter().map(|p| (p.frequency_hz, p.outputs[o].harmonics[k].0)).collect(),
-            unstable: level.points.iter().map(is_unstable).collect(),
+            dashed: level.points.iter().map(is_unstable).collect(),
         })
         .collect();
     Chart {
@@ -386,7 +386,7 @@ pub fn plot_hysteresis(path: &Path, level_n: f64, point: &PointRecord, element: 
         x_label: "Displacement (m)".into(),
         y_label: "Force (N)".into(),
         log_y: false,
-        curves: vec![Curve { label: element.into(), points, unstable: Vec::new() }],
+        curves: vec![Curve { label: element.into(), points, dashed: Vec::new() }],
         markers: Vec::new(),
     }
     .render(path)
@@ -403,7 +403,7 @@ pub fn plot_slider_velocity(path: &Path, level_n: f64, point: &PointRecord, elem
         x_label: "Time (ms)".into(),
         y_label: "Velocity (m/s)".into(),
         log_y: false,
-        curves: vec![Curve { label: element.into(), points, unstable: Vec::new() }],
+        curves: vec![Curve { label: element.into(), points, dashed: Vec::new() }],
         markers: Vec::new(),
     }
     .render(path)
@@ -427,9 +427,9 @@ pub fn plot_joint_sides(path: &Path, snapshot: &SnapshotResult, sides: &JointSid
             Curve {
                 label: format!("{} = {} + slip velocity (Eq. 33)", sides.dof_a, sides.dof_b),
                 points: two_periods(&sides.velocity_a),
-                unstable: Vec::new(),
+                dashed: Vec::new(),
             },
-            Curve { label: sides.dof_b.clone(), points: two_periods(&sides.velocity_b), unstable: Vec::new() },
+            Curve { label: sides.dof_b.clone(), points: two_periods(&sides.velocity_b), dashed: Vec::new() },
         ],
         markers: Vec::new(),
     }
@@ -491,7 +491,7 @@ pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Resu
         curves.push(Curve {
             label: format!("{} N", l.level_n),
             points,
-            unstable: l.points.iter().map(is_unstable).collect(),
+            dashed: l.points.iter().map(is_unstable).collect(),
         });
     }
     Chart {
@@ -540,7 +540,7 @@ pub fn plot_time_records(path: &Path, title: &str, records: &TimeRecords, unit: 
                 .step_by(stride)
                 .map(|(j, &v)| (records.start_s + j as f64 * dt, v))
                 .collect(),
-            unstable: Vec::new(),
+            dashed: Vec::new(),
         })
         .collect();
     if curves.is_empty() {
@@ -605,7 +605,7 @@ pub fn plot_frf_set(dir: &Path, stem: &str, set: &FrfSet, format: PlotFormat) ->
                 .map(|c| Curve {
                     label: c.name.clone(),
                     points: set.frequency_hz.iter().zip(&c.values).map(|(&f, &v)| (f, value(v))).collect(),
-                    unstable: Vec::new(),
+                    dashed: Vec::new(),
                 })
                 .collect()
         };
@@ -791,6 +791,46 @@ fn render_against_amplitude(path: &Path, title: &str, y_label: &str, points: &[(
         }
         _ => Err(plot_error("the plot file name must end in .png or .svg".into())),
     }
+}
+
+/// The displacement FRF of `output` per level by the harmonic balance (solid) beside the one
+/// synthesised from the nonlinear mode alone (dashed, [`crate::backbone::single_mode_frfs`];
+/// `o` is the output's index among the backbone's), so that a reader sees where a single mode
+/// holds.
+pub fn plot_single_mode(
+    path: &Path,
+    levels: &[LevelResult],
+    output: &str,
+    synthesised: &[crate::backbone::SingleModeFrf],
+    o: usize,
+) -> Result<(), OutputError> {
+    let mut curves = Vec::new();
+    for l in levels {
+        if let Some(p0) = l.points.first() {
+            let i = output_index(p0, output)?;
+            let points = l.points.iter().map(|p| (p.frequency_hz, p.outputs[i].disp_frf)).collect();
+            curves.push(Curve { label: format!("{} N", l.level_n), points, dashed: Vec::new() });
+        }
+    }
+    // The synthesised curves reach far from the resonance; drawn over the harmonic balance's
+    // band only, where the two are compared.
+    let (lo, hi) = min_max(levels.iter().flat_map(|l| l.points.iter().map(|p| p.frequency_hz)));
+    for frf in synthesised {
+        let level = frf.level_n;
+        let points: Vec<(f64, f64)> =
+            frf.points.iter().filter(|(f, _)| (lo..=hi).contains(f)).map(|(f, v)| (*f, v[o])).collect();
+        let dashed = vec![true; points.len()];
+        curves.push(Curve { label: format!("{level} N, one mode"), points, dashed });
+    }
+    Chart {
+        title: format!("FRF of {output}: harmonic balance (solid) and single nonlinear mode (dashed)"),
+        x_label: "Frequency (Hz)".into(),
+        y_label: "Displacement / force (m/N)".into(),
+        log_y: true,
+        curves,
+        markers: Vec::new(),
+    }
+    .render(path)
 }
 
 /// The backbone of a nonlinear mode: `backbone_frequency` (Hz) and `backbone_damping`

@@ -8,7 +8,8 @@ use anyhow::Context;
 use stickslip_core::continuation::Point;
 use stickslip_core::model::NonlinearModel;
 use stickslip_io::analysis::{describe_termination, run_nonlinear_mode};
-use stickslip_io::backbone::write_backbone_csv;
+use stickslip_io::backbone::{single_mode_frfs, write_backbone_csv, write_single_mode_csv};
+use stickslip_io::output::LevelResult;
 use stickslip_io::study::{OutputSpec, PlotFormat, Study};
 
 #[derive(clap::Args)]
@@ -37,12 +38,15 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let (model, _, outputs) = study.build_model()?;
     let plots = (!args.no_plots).then_some(study.output_options.plot_format);
-    compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet)?;
+    compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet, None)?;
     Ok(())
 }
 
 /// Compute the backbone of `study`'s `[nonlinear_mode]` (nothing without one) and write
-/// `backbone.csv` and, with `plots`, its two plots into `out`. Returns the files written.
+/// `backbone.csv` and, with `plots`, its two plots into `out`. With `forced` (the excitation
+/// pattern and the levels the harmonic balance computed), also the forced responses
+/// synthesised from the mode alone, `single_mode_frf.csv`, and per output their plot beside
+/// the harmonic balance's. Returns the files written.
 pub fn compute_and_write(
     study: &Study,
     model: &NonlinearModel,
@@ -50,6 +54,7 @@ pub fn compute_and_write(
     out: &Path,
     plots: Option<PlotFormat>,
     quiet: bool,
+    forced: Option<(&[f64], &[LevelResult])>,
 ) -> anyhow::Result<Vec<PathBuf>> {
     let started = Instant::now();
     let mut observer = |p: &Point, _: f64| {
@@ -71,6 +76,20 @@ pub fn compute_and_write(
     let mut files = vec![csv];
     if let Some(format) = plots {
         files.extend(stickslip_io::plot::plot_backbone(out, &backbone, format)?);
+    }
+    if let Some((load, levels)) = forced {
+        let levels_n: Vec<f64> = levels.iter().map(|l| l.level_n).collect();
+        let frfs = single_mode_frfs(&backbone, load, &levels_n);
+        let csv = out.join("single_mode_frf.csv");
+        write_single_mode_csv(&csv, &frfs, &names)?;
+        files.push(csv);
+        if let Some(format) = plots {
+            for (o, name) in names.iter().enumerate() {
+                let path = out.join(format!("frf_single_mode_{name}.{}", format.extension()));
+                stickslip_io::plot::plot_single_mode(&path, levels, name, &frfs, o)?;
+                files.push(path);
+            }
+        }
     }
     let (first, last) = (backbone.points.first(), backbone.points.last());
     if let (Some(first), Some(last)) = (first, last) {

@@ -135,10 +135,10 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     // The [nonlinear_mode] backbone, when the study asks for one; a failure is reported at the
     // end with the incomplete levels, after everything else is written.
     let backbone_started = Instant::now();
-    let backbone = study
-        .nonlinear_mode
-        .as_ref()
-        .map(|_| super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet));
+    let backbone = study.nonlinear_mode.as_ref().map(|_| {
+        let forced = Some((excitation.pattern.as_slice(), levels.as_slice()));
+        super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet, forced)
+    });
     if let Some(Ok(written)) = &backbone {
         files.extend(written.iter().cloned());
         timings.push(("nonlinear mode".into(), backbone_started.elapsed().as_secs_f64()));

@@ -203,6 +203,69 @@ pub struct Backbone {
     pub notes: Vec<String>,
     /// The raw continuation branch (call counts, residuals); `None` without joints.
     pub branch: Option<Branch>,
+    /// The target mode's viscous modal coefficient `c_*` (1/s) and its mass-normalised shape
+    /// (n): what the forced response synthesised from the backbone needs
+    /// ([`Backbone::single_mode_response`]).
+    pub viscous: f64,
+    pub shape: Vec<f64>,
+}
+
+/// One point of a forced response synthesised from a backbone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SynthesisedPoint {
+    /// Excitation frequency Ω (rad/s).
+    pub omega: f64,
+    /// The backbone point it comes from (its modal amplitude is the response's).
+    pub point: usize,
+}
+
+impl Backbone {
+    /// The forced response near the mode's resonance under `level · load cos Ωt`, from the
+    /// backbone alone (single nonlinear mode theory, Krack 2015, Section 5): the structure is
+    /// assumed to move in the nonlinear mode, whose amplitude `a` answers the force as
+    ///
+    /// ```text
+    /// [ω(a)² − Ω² + i (Ω c_* + ω(a) (ξ(a) − c_*))] a = φᵀF e^{iψ}
+    /// ```
+    ///
+    /// with the viscous damping `c_*` acting at the forcing frequency and the joints' part
+    /// `ξ − c_*` (rate independent) at the mode's, where it was computed. For each backbone
+    /// point the frequencies Ω below and above `ω(a)` solving the modulus of this equation
+    /// (bisection: the left side is monotone on each side); a point above the peak of this force
+    /// has none. The response at an output is the backbone point's own (same modal amplitude).
+    /// Returned in frequency order along the curve: the lower side by rising amplitude, then
+    /// the upper side by falling amplitude.
+    pub fn single_mode_response(&self, load: &[f64], level: f64) -> Vec<SynthesisedPoint> {
+        let force = level * self.shape.iter().zip(load).map(|(p, f)| p * f).sum::<f64>();
+        let c = self.viscous;
+        let (mut lower, mut upper) = (Vec::new(), Vec::new());
+        for (i, p) in self.points.iter().enumerate() {
+            let (w, beta) = (p.omega, p.omega * (p.xi - c));
+            let f = |o: f64| (w * w - o * o).powi(2) + (o * c + beta).powi(2) - (force / p.amplitude).powi(2);
+            if f(w) >= 0.0 || f(w).is_nan() {
+                continue;
+            }
+            for (side, (lo, hi)) in [(&mut lower, (0.0, w)), (&mut upper, (w, 2.0 * w))] {
+                if f(lo) * f(hi) > 0.0 {
+                    continue;
+                }
+                let (mut lo, mut hi) = (lo, hi);
+                let rising = f(hi) > f(lo);
+                for _ in 0..100 {
+                    let mid = 0.5 * (lo + hi);
+                    if (f(mid) > 0.0) == rising {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                side.push(SynthesisedPoint { omega: 0.5 * (lo + hi), point: i });
+            }
+        }
+        upper.reverse();
+        lower.extend(upper);
+        lower
+    }
 }
 
 impl<'m> NonlinearMode<'m> {
@@ -742,6 +805,8 @@ pub fn nonlinear_mode<O: Observer + ?Sized>(
         termination: branch.termination.clone(),
         notes: Vec::new(),
         branch: Some(branch),
+        viscous: problem.c_t,
+        shape: problem.shapes.col(settings.mode).iter().copied().collect(),
     })
 }
 
@@ -800,5 +865,7 @@ fn linear_backbone(
             c / (2.0 * omega)
         )],
         branch: None,
+        viscous: c,
+        shape: modes.shapes.col(r).iter().copied().collect(),
     })
 }
