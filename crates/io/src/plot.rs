@@ -339,11 +339,23 @@ fn bifurcation_symbol(kind: &str) -> &'static str {
 
 /// One FRF plot per output, `dir/frf_<output>.<png|svg>`; returns the files written.
 pub fn plot_frfs(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    per_output(dir, levels, format, "frf", plot_frf)
+}
+
+/// `plot(dir/<stem>_<output>.<ext>, levels, output)` for every output of the levels' points;
+/// returns the files written.
+fn per_output(
+    dir: &Path,
+    levels: &[LevelResult],
+    format: PlotFormat,
+    stem: &str,
+    plot: fn(&Path, &[LevelResult], &str) -> Result<(), OutputError>,
+) -> Result<Vec<PathBuf>, OutputError> {
     let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(Vec::new()) };
     let mut files = Vec::new();
     for o in &first.outputs {
-        let path = dir.join(format!("frf_{}.{}", o.name, format.extension()));
-        plot_frf(&path, levels, &o.name)?;
+        let path = dir.join(format!("{stem}_{}.{}", o.name, format.extension()));
+        plot(&path, levels, &o.name)?;
         files.push(path);
     }
     Ok(files)
@@ -508,14 +520,7 @@ pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Resu
 /// One phase plot per output, `dir/frf_phase_<output>.<png|svg>`, beside the amplitude plots of
 /// [`plot_frfs`]; returns the files written.
 pub fn plot_frf_phases(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
-    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(Vec::new()) };
-    let mut files = Vec::new();
-    for o in &first.outputs {
-        let path = dir.join(format!("frf_phase_{}.{}", o.name, format.extension()));
-        plot_frf_phase(&path, levels, &o.name)?;
-        files.push(path);
-    }
-    Ok(files)
+    per_output(dir, levels, format, "frf_phase", plot_frf_phase)
 }
 
 /// Most points drawn per curve of a time record: a swept sine holds millions of samples, which

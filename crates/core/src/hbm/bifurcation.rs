@@ -95,7 +95,7 @@ pub fn stability_at(
         let mut s = start;
         let mut previous_change = f64::INFINITY;
         for _ in 0..MEMORY_ITERATIONS {
-            let jac = hbm.element_force_jacobian_delayed(x, omega, s)?;
+            let jac = hbm.delayed_force_jacobian(omega, s);
             let all = hill.eigenvalues(omega, jac.as_ref())?;
             let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
             let change = (next - s).norm();

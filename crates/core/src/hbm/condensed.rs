@@ -351,19 +351,19 @@ impl<'m> CondensedHbm<'m> {
         Ok(Mat::from_fn(jac.nrows(), jac.ncols(), |i, j| jac[(i, j)].re))
     }
 
-    /// `∂G/∂x` for a perturbation `e^{st} p(t)` of the solution at `x`, Ω (complex, same layout
-    /// as [`Self::element_force_jacobian`]): the sliders' memory of their anchor weighted by
-    /// `e^{−sΔ}` ([`ElementAft::add_memory_delay`]).
-    pub fn element_force_jacobian_delayed(&mut self, x: &[f64], omega: f64, s: c64) -> Result<Mat<c64>, HbmError> {
-        self.element_forces(x, omega, true)?;
+    /// `∂G/∂x` for a perturbation `e^{st} p(t)` of the solution last given to
+    /// [`Self::element_force_jacobian`] (complex, same layout): the sliders' memory of their
+    /// anchor weighted by `e^{−sΔ}` ([`ElementAft::add_memory_delay`]). The AFT is not run
+    /// again: only the weights change with `s`.
+    pub fn delayed_force_jacobian(&self, omega: f64, s: c64) -> Mat<c64> {
         let (afts, plan) = (&self.joints.afts, &self.plan);
-        Ok(self.joints.assembled_jacobian(self.model, plan.n_coeffs(), |e, block| {
+        self.joints.assembled_jacobian(self.model, plan.n_coeffs(), |e, block| {
             afts[e].add_memory_delay(plan, omega, s, block);
-        }))
+        })
     }
 
     /// Did the last Jacobian include a slider's memory of its anchor, which a perturbation
-    /// `e^{st}` delays ([`Self::element_force_jacobian_delayed`])?
+    /// `e^{st}` delays ([`Self::delayed_force_jacobian`])?
     pub fn has_memory_delay(&self) -> bool {
         self.joints.has_memory_delay()
     }

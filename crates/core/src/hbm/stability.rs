@@ -142,7 +142,7 @@ impl Hill {
     }
 
     /// Every eigenvalue of Hill's problem with the joints' Jacobian `jacobian` (complex when
-    /// it depends on the exponent: [`super::CondensedHbm::element_force_jacobian_delayed`]).
+    /// it depends on the exponent: [`super::CondensedHbm::delayed_force_jacobian`]).
     pub fn eigenvalues(&self, omega: f64, jacobian: MatRef<'_, c64>) -> Result<Vec<c64>, StabilityError> {
         let q = self.a.nrows();
         let m = self.n_modes();
