@@ -82,3 +82,62 @@ pub fn chain_with_joints(n: usize, q: usize, grounded: bool) -> NonlinearModel {
 pub fn labels(n: usize) -> Vec<DofLabel> {
     (0..n).map(|i| DofLabel::named(format!("x{i}"))).collect()
 }
+
+/// A square patch of `side × side` nodes pressed on a rigid ground, each node a 3-D contact
+/// (two tangential directions, then the normal): a plate of 3 DOFs per node (0.5 kg each),
+/// neighbours tied by springs of 2e7 N/m per direction, softly supported (1e5 N/m per DOF), with
+/// contacts of k_t = 2.5e6 N/m, k_n = 5e6 N/m, μ = 0.5 and a preload that falls from 400 N at
+/// the centre to 40 N at the corners, as under a bolt. The patch slides on its stuck contacts
+/// at about 360 Hz. Forced tangentially at a corner node (its first DOF): at a moderate level
+/// the centre sticks while the edges slip and lift off, as in a real joint.
+pub fn contact_patch(side: usize) -> (NonlinearModel, Vec<f64>) {
+    use stickslip_core::elements::Contact;
+    let nodes = side * side;
+    let n = 3 * nodes;
+    let (kc, ks) = (2.0e7, 1.0e5);
+    let mut k = Mat::<f64>::zeros(n, n);
+    for node in 0..nodes {
+        let (x, y) = (node % side, node / side);
+        for dof in 0..3 {
+            k[(3 * node + dof, 3 * node + dof)] += ks;
+        }
+        let mut tie = |other: usize| {
+            for dof in 0..3 {
+                let (a, b) = (3 * node + dof, 3 * other + dof);
+                k[(a, a)] += kc;
+                k[(b, b)] += kc;
+                k[(a, b)] -= kc;
+                k[(b, a)] -= kc;
+            }
+        };
+        if x + 1 < side {
+            tie(node + 1);
+        }
+        if y + 1 < side {
+            tie(node + side);
+        }
+    }
+    let alpha = 2.0 * 0.01 * TWO_PI * 300.0;
+    let linear = LinearModel::new(
+        dense(n, |i, j| if i == j { 0.5 } else { 0.0 }),
+        Matrix::Dense(k),
+        Damping::Rayleigh { alpha, beta: 0.0 },
+        labels(n),
+        vec![],
+    )
+    .unwrap();
+    let centre = (side as f64 - 1.0) / 2.0;
+    let sites = (0..nodes)
+        .map(|node| {
+            let (x, y) = ((node % side) as f64 - centre, (node / side) as f64 - centre);
+            let r2 = (x * x + y * y) / (2.0 * centre * centre).max(1.0);
+            let preload = 40.0 + 360.0 * (1.0 - r2);
+            let law: Box<dyn Element> = Box::new(Contact::new_3d(2.5e6, 5e6, 0.5, preload).unwrap());
+            let directions = (0..3).map(|a| relative_direction(n, 3 * node + a, None)).collect();
+            ElementSite { name: format!("contact{node}"), law, directions }
+        })
+        .collect();
+    let mut force = vec![0.0; n];
+    force[0] = 1.0;
+    (NonlinearModel::new(linear, sites).unwrap(), force)
+}

@@ -68,7 +68,7 @@ pub fn maximise_along<P: Problem>(
         return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
     }
 
-    let mut path = ChordPath::new(n, &z0, &z1, x_scale, lambda_scale);
+    let mut path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
     let mut z = vec![0.0; n + 1];
     let mut solves = 0;
     // The point at s: from the last point solved if it is near (the scan's neighbours, one or
@@ -173,7 +173,7 @@ pub fn zero_along<P: Problem>(
         p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
     };
     let (z0, z1) = (scaled(before), scaled(after));
-    let mut path = ChordPath::new(n, &z0, &z1, x_scale, lambda_scale);
+    let mut path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
     let (mut a, mut b) = ((0.0, z0.clone()), (1.0, z1.clone()));
     let mut value = |problem: &mut P, z: &[f64]| {
         let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
@@ -244,14 +244,15 @@ struct ChordPath {
 }
 
 impl ChordPath {
-    fn new(n: usize, z0: &[f64], z1: &[f64], x_scale: f64, lambda_scale: f64) -> Self {
+    fn new<P: Problem>(problem: &mut P, z0: &[f64], z1: &[f64], x_scale: f64, lambda_scale: f64) -> Self {
+        let n = problem.dimension();
         ChordPath {
             n,
             z0: z0.to_vec(),
             chord: z1.iter().zip(z0).map(|(b, a)| b - a).collect(),
             x_scale,
             lambda_scale,
-            workspace: Workspace::new(n),
+            workspace: Workspace::new(problem),
             x: vec![0.0; n],
         }
     }
@@ -270,8 +271,7 @@ impl ChordPath {
                 *xi = zi * self.x_scale;
             }
             let lambda = z[n] * self.lambda_scale;
-            let (residual, jx, jl) = self.workspace.evaluation_buffers();
-            match problem.evaluate(&self.x, lambda, residual, Some((jx, jl))) {
+            match self.workspace.evaluate(problem, &self.x, lambda, true) {
                 Ok(()) => {}
                 // A law that fails on this iterate: the point cannot be solved, not the search.
                 Err(e) if e.at_trial_iterate => return Ok(false),
@@ -290,7 +290,7 @@ impl ChordPath {
             }
             workspace.rhs[n] = -constraint;
             if !workspace.residual.iter().all(|r| r.is_finite())
-                || !workspace.solve_bordered(self.x_scale, self.lambda_scale, residual_scale, &self.chord)
+                || !workspace.solve_bordered(problem, self.x_scale, self.lambda_scale, residual_scale, &self.chord)
             {
                 return Ok(false);
             }

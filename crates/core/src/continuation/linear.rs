@@ -1,10 +1,14 @@
-//! The dense linear systems of the corrector: the bordered `(n+1)×(n+1)` system of Eq. 32 and
-//! the `n×n` system of a solve at fixed λ, factored by partial-pivot LU in place on buffers
-//! allocated once per branch (no allocation per Newton iteration).
+//! The linear systems of the corrector: the bordered `(n+1)×(n+1)` system of Eq. 32 and the
+//! `n×n` system of a solve at fixed λ. Dense: factored by partial-pivot LU in place on buffers
+//! allocated once per branch (no allocation per Newton iteration). For a problem that factors
+//! its own Jacobian ([`Problem::factored`]): by block elimination of the border, two solves
+//! with `∂R/∂x`.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::{Mat, MatMut, Par};
+
+use super::{Problem, ProblemError};
 
 /// Workspace for the corrector: Jacobian buffers, LU factors and right-hand side.
 pub(super) struct Workspace {
@@ -19,18 +23,31 @@ pub(super) struct Workspace {
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     scratch: MemBuffer,
+    /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
+    factored: bool,
+    /// Factored: the last factorisation was singular.
+    singular: bool,
+    /// Factored: `(∂R/∂x)⁻¹ ∂R/∂λ` for the border.
+    border: Vec<f64>,
 }
 
 impl Workspace {
-    pub fn new(n: usize) -> Self {
+    /// Buffers for `problem`, dense unless it factors its own Jacobian.
+    pub fn new<P: Problem + ?Sized>(problem: &mut P) -> Self {
+        let n = problem.dimension();
+        let factored = problem.factored().is_some();
+        let size = if factored { 0 } else { n + 1 };
         let par = Par::Seq;
         let req = StackReq::any_of(&[
-            factor::lu_in_place_scratch::<usize, f64>(n + 1, n + 1, par, Default::default()),
-            solve::solve_in_place_scratch::<usize, f64>(n + 1, 1, par),
+            factor::lu_in_place_scratch::<usize, f64>(size, size, par, Default::default()),
+            solve::solve_in_place_scratch::<usize, f64>(size, 1, par),
         ]);
         Workspace {
             n,
-            matrix: Mat::zeros(n + 1, n + 1),
+            matrix: Mat::zeros(size, size),
+            factored,
+            singular: false,
+            border: if factored { vec![0.0; n] } else { Vec::new() },
             dr_dlambda: vec![0.0; n],
             residual: vec![0.0; n],
             rhs: vec![0.0; n + 1],
@@ -40,23 +57,67 @@ impl Workspace {
         }
     }
 
-    /// The residual buffer and zeroed ∂R/∂x, ∂R/∂λ buffers for the problem to fill.
-    pub fn evaluation_buffers(&mut self) -> (&mut [f64], MatMut<'_, f64>, &mut [f64]) {
+    /// Evaluate `problem` at `(x, λ)`: the residual into `self.residual` and, with
+    /// `with_jacobian`, `∂R/∂λ` and `∂R/∂x` (dense into the matrix, or factored by the problem).
+    pub fn evaluate<P: Problem + ?Sized>(
+        &mut self,
+        problem: &mut P,
+        x: &[f64],
+        lambda: f64,
+        with_jacobian: bool,
+    ) -> Result<(), ProblemError> {
         let n = self.n;
+        self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
+        if !with_jacobian {
+            return problem.evaluate(x, lambda, &mut self.residual, None);
+        }
+        if self.factored {
+            let factored = problem.factored().expect("the problem said it factors its Jacobian");
+            self.singular = !factored.evaluate_and_factor(x, lambda, &mut self.residual, &mut self.dr_dlambda)?;
+            return Ok(());
+        }
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
-        self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
-        (&mut self.residual, jx, &mut self.dr_dlambda)
+        problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))
     }
 
     /// Solve the bordered system of Eq. 32 in scaled variables,
-    /// `[∂R/∂x·s_x/s_R  ∂R/∂λ·s_λ/s_R; tᵀ] Δz = rhs`, with the Jacobian the problem last wrote.
-    /// The factorisation destroys the Jacobian. Returns false when the solution is not finite
-    /// (singular bordered matrix).
-    pub fn solve_bordered(&mut self, x_scale: f64, lambda_scale: f64, residual_scale: f64, t: &[f64]) -> bool {
+    /// `[∂R/∂x·s_x/s_R  ∂R/∂λ·s_λ/s_R; tᵀ] Δz = rhs`, with the Jacobian of the last
+    /// evaluation. A dense factorisation destroys the Jacobian. Returns false when the
+    /// solution is not finite (singular bordered matrix).
+    pub fn solve_bordered<P: Problem + ?Sized>(
+        &mut self,
+        problem: &mut P,
+        x_scale: f64,
+        lambda_scale: f64,
+        residual_scale: f64,
+        t: &[f64],
+    ) -> bool {
         let n = self.n;
         let cx = x_scale / residual_scale;
         let cl = lambda_scale / residual_scale;
+        if self.factored {
+            // [cx J  cl r_λ; t_xᵀ t_λ] [a; α] = [b; β]: with y₁ = J⁻¹ b / cx and
+            // y₂ = J⁻¹ r_λ · cl / cx, α = (β − t_xᵀ y₁) / (t_λ − t_xᵀ y₂) and a = y₁ − α y₂.
+            let Some(factored) = problem.factored().filter(|_| !self.singular) else { return false };
+            self.border.copy_from_slice(&self.dr_dlambda);
+            if !factored.solve(&mut self.rhs[..n]) || !factored.solve(&mut self.border) {
+                return false;
+            }
+            let (mut t_y1, mut t_y2) = (0.0, 0.0);
+            for i in 0..n {
+                self.rhs[i] /= cx;
+                self.border[i] *= cl / cx;
+                t_y1 += t[i] * self.rhs[i];
+                t_y2 += t[i] * self.border[i];
+            }
+            let alpha = (self.rhs[n] - t_y1) / (t[n] - t_y2);
+            for i in 0..n {
+                self.rhs[i] -= alpha * self.border[i];
+            }
+            self.rhs[n] = alpha;
+            return self.rhs.iter().all(|v| v.is_finite());
+        }
         for j in 0..n {
             for i in 0..n {
                 self.matrix[(i, j)] *= cx;
@@ -72,9 +133,17 @@ impl Workspace {
     }
 
     /// Solve `∂R/∂x·s_x/s_R Δu = rhs[..n]` (a Newton step at fixed λ).
-    pub fn solve_fixed(&mut self, x_scale: f64, residual_scale: f64) -> bool {
+    pub fn solve_fixed<P: Problem + ?Sized>(&mut self, problem: &mut P, x_scale: f64, residual_scale: f64) -> bool {
         let n = self.n;
         let cx = x_scale / residual_scale;
+        if self.factored {
+            let Some(factored) = problem.factored().filter(|_| !self.singular) else { return false };
+            if !factored.solve(&mut self.rhs[..n]) {
+                return false;
+            }
+            self.rhs[..n].iter_mut().for_each(|v| *v /= cx);
+            return self.rhs[..n].iter().all(|v| v.is_finite());
+        }
         for j in 0..n {
             for i in 0..n {
                 self.matrix[(i, j)] *= cx;

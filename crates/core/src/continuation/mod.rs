@@ -140,6 +140,31 @@ pub trait Problem {
     fn scales(&self) -> Scales {
         Scales::default()
     }
+
+    /// A problem too large for a dense Jacobian (thousands of unknowns) may factor `∂R/∂x` by
+    /// its own structure: when this returns `Some`, the corrector never asks [`Self::evaluate`]
+    /// for `∂R/∂x` and solves its systems through [`FactoredJacobian`] instead (the bordered
+    /// system of Eq. 32 by block elimination). `None`, the default: dense LU.
+    fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
+        None
+    }
+}
+
+/// `∂R/∂x` factored by the problem itself ([`Problem::factored`]).
+pub trait FactoredJacobian {
+    /// `R(x, λ)` into `residual`, `∂R/∂λ` into `dr_dlambda`, and `∂R/∂x` factored for
+    /// [`Self::solve`]. Errors as [`Problem::evaluate`]; `Ok(false)` if `∂R/∂x` is singular.
+    fn evaluate_and_factor(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        dr_dlambda: &mut [f64],
+    ) -> Result<bool, ProblemError>;
+
+    /// Overwrite `rhs` with `(∂R/∂x)⁻¹ rhs` at the last factored point; false if the result
+    /// is not finite.
+    fn solve(&mut self, rhs: &mut [f64]) -> bool;
 }
 
 /// Typical magnitudes a problem may impose (positive and finite when given).

@@ -193,6 +193,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
     fn new(problem: &'a mut P, options: &'a Options, lambda_start: f64, lambda_end: f64) -> Self {
         let n = problem.dimension();
         let zeros = vec![0.0; n + 1];
+        let ws = Workspace::new(problem);
         Runner {
             problem,
             options,
@@ -202,7 +203,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             direction: (lambda_end - lambda_start).signum(),
             scale: Scaling { x: 1.0, lambda: (lambda_end - lambda_start).abs(), residual: 1.0, x_fixed: false },
             tolerance: 0.0,
-            ws: Workspace::new(n),
+            ws,
             calls: Calls::default(),
             total: Calls::default(),
             z: zeros.clone(),
@@ -526,12 +527,10 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
 
     /// Evaluate the problem at `x_phys`, `lambda`; returns `‖R‖`.
     fn evaluate(&mut self, lambda: f64, with_jacobian: bool) -> Result<f64, ProblemError> {
-        let (residual, jx, dl) = self.ws.evaluation_buffers();
         let calls = Calls { residuals: 1, jacobians: usize::from(with_jacobian), factorizations: 0 };
         self.calls += calls;
         self.total += calls;
-        let jacobian = if with_jacobian { Some((jx, dl)) } else { None };
-        self.problem.evaluate(&self.x_phys, lambda, residual, jacobian)?;
+        self.ws.evaluate(self.problem, &self.x_phys, lambda, with_jacobian)?;
         Ok(norm(&self.ws.residual))
     }
 
@@ -594,9 +593,9 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 Constraint::Arclength => {
                     let offset: f64 = (0..=n).map(|i| self.t[i] * (self.z[i] - self.z_pred[i])).sum();
                     self.ws.rhs[n] = -offset;
-                    (self.ws.solve_bordered(self.scale.x, self.scale.lambda, sr, &self.t), n + 1)
+                    (self.ws.solve_bordered(self.problem, self.scale.x, self.scale.lambda, sr, &self.t), n + 1)
                 }
-                Constraint::FixedLambda(_) => (self.ws.solve_fixed(self.scale.x, sr), n),
+                Constraint::FixedLambda(_) => (self.ws.solve_fixed(self.problem, self.scale.x, sr), n),
             };
             if !solved {
                 return Outcome::Failed { iterations, residual_norm, cause: Rejection::Singular };
@@ -618,7 +617,8 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         self.ws.rhs[n] = 1.0;
         self.calls.factorizations += 1;
         self.total.factorizations += 1;
-        if !self.ws.solve_bordered(self.scale.x, self.scale.lambda, self.scale.residual, &self.reference) {
+        if !self.ws.solve_bordered(self.problem, self.scale.x, self.scale.lambda, self.scale.residual, &self.reference)
+        {
             return false;
         }
         let length = norm(&self.ws.rhs);

@@ -25,6 +25,7 @@ use super::element_aft::{AftError, ElementAft};
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
 use super::receptance::{HarmonicReceptance, Receptance};
+use super::structured::StructuredJacobian;
 use crate::model::{ModelError, NonlinearModel};
 
 /// Numerical settings of the harmonic balance.
@@ -59,6 +60,11 @@ pub enum HbmError {
     ForceLength { got: usize, expected: usize },
 }
 
+/// Size of the condensed problem ((2N+1)q unknowns) from which the Newton systems are solved
+/// by their structure ([`StructuredJacobian`]): below it a dense LU costs a few milliseconds
+/// and the structure saves nothing.
+pub const FACTOR_BY_STRUCTURE_FROM: usize = 500;
+
 /// The condensed harmonic balance of a [`NonlinearModel`] under `λ_F F cos Ωt`.
 pub struct CondensedHbm<'m> {
     model: &'m NonlinearModel,
@@ -70,6 +76,13 @@ pub struct CondensedHbm<'m> {
     joints: JointForces,
     harmonic: Vec<HarmonicReceptance>,
     h0: Mat<f64>,
+    /// Complex force amplitudes of one harmonic and a receptance product, reused.
+    amplitudes: Vec<c64>,
+    product: Vec<c64>,
+    /// `∂R/∂x` of the last [`Self::evaluate_factored`].
+    factored: Option<StructuredJacobian>,
+    /// Solve Newton systems by [`StructuredJacobian`] rather than a dense LU.
+    by_structure: bool,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -91,7 +104,7 @@ impl<'m> CondensedHbm<'m> {
         let joints = JointForces::new(model, &plan);
         // Static receptance H(0) = Vᵀ K⁻¹ V (real).
         let mut h = HarmonicReceptance::new(q);
-        receptance.evaluate(0.0, &mut h);
+        receptance.evaluate_matrix(0.0, &mut h);
         let h0 = Mat::from_fn(q, q, |i, j| h.h[(i, j)].re);
         Ok(CondensedHbm {
             model,
@@ -101,6 +114,10 @@ impl<'m> CondensedHbm<'m> {
             joints,
             harmonic: (0..settings.harmonics).map(|_| HarmonicReceptance::new(q)).collect(),
             h0,
+            amplitudes: vec![c64::new(0.0, 0.0); q],
+            product: vec![c64::new(0.0, 0.0); q],
+            factored: None,
+            by_structure: q * plan.n_coeffs() >= FACTOR_BY_STRUCTURE_FROM,
             plan,
             evaluations: 0,
         })
@@ -155,6 +172,13 @@ impl<'m> CondensedHbm<'m> {
         let n = self.dimension();
         let zero = vec![0.0; n];
         let mut r = vec![0.0; n];
+        if self.by_structure {
+            // At rest every element is linear: the structured factorisation is the cheap one.
+            self.evaluate_factored(&zero, omega, level, &mut r, None, None)?;
+            if self.solve_factored(&mut r) {
+                return Ok(r.iter().map(|v| -v).collect());
+            }
+        }
         let mut jac = Mat::zeros(n, n);
         self.evaluate(&zero, omega, level, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))?;
         let dx = jac.partial_piv_lu().solve(Mat::from_fn(n, 1, |i, _| r[i]));
@@ -170,13 +194,35 @@ impl<'m> CondensedHbm<'m> {
         residual: &mut [f64],
         jacobian: Option<Jacobians<'_>>,
     ) -> Result<(), HbmError> {
+        let want = jacobian.is_some();
+        self.residual(x, omega, level, residual, want)?;
+        if let Some(Jacobians { dx, domega, dlevel }) = jacobian {
+            self.assemble_jacobian(dx, self.plan.n_coeffs());
+            self.parameter_derivatives(level, domega, dlevel);
+        }
+        Ok(())
+    }
+
+    /// The residual, with what the Jacobian needs (`∂G`, the matrices `H_k`) if `want`.
+    fn residual(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        level: f64,
+        residual: &mut [f64],
+        want: bool,
+    ) -> Result<(), HbmError> {
         self.evaluations += 1;
         let q = self.q;
-        let nc = self.plan.n_coeffs();
-        let want = jacobian.is_some();
         self.element_forces(x, omega, want)?;
         for k in 1..=self.plan.n_harmonics() {
-            self.receptance.evaluate(k as f64 * omega, &mut self.harmonic[k - 1]);
+            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone.
+            let hr = &mut self.harmonic[k - 1];
+            if want {
+                self.receptance.evaluate_matrix(k as f64 * omega, hr);
+            } else {
+                self.receptance.evaluate(k as f64 * omega, hr);
+            }
         }
         // Harmonic 0: R_0 = x_0 + H(0) G_0.
         for i in 0..q {
@@ -186,34 +232,74 @@ impl<'m> CondensedHbm<'m> {
             }
             residual[i] = r;
         }
+        // Harmonic k: R_k = x_k − λ_F u_F δ_k1 + H_k G_k in the complex form c − i s.
         for k in 1..=self.plan.n_harmonics() {
-            let hr = &self.harmonic[k - 1];
             let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+            let g = &self.joints.g;
+            for (j, a) in self.amplitudes.iter_mut().enumerate() {
+                *a = c64::new(g[ic + j], -g[is + j]);
+            }
+            let hr = &self.harmonic[k - 1];
+            self.receptance.apply(hr, &self.amplitudes, &mut self.product);
             for i in 0..q {
-                let mut rc = x[ic + i];
-                let mut rs = x[is + i];
+                let mut rc = x[ic + i] + self.product[i].re;
+                let mut rs = x[is + i] - self.product[i].im;
                 if k == 1 {
                     rc -= level * hr.u_force[i].re;
                     rs += level * hr.u_force[i].im;
-                }
-                for j in 0..q {
-                    let h = hr.h[(i, j)];
-                    rc += h.re * self.joints.g[ic + j] + h.im * self.joints.g[is + j];
-                    rs += -h.im * self.joints.g[ic + j] + h.re * self.joints.g[is + j];
                 }
                 residual[ic + i] = rc;
                 residual[is + i] = rs;
             }
         }
-        if let Some(jac) = jacobian {
-            self.jacobians(level, jac, nc);
-        }
         Ok(())
     }
 
-    fn jacobians(&mut self, level: f64, jac: Jacobians<'_>, nc: usize) {
+    /// [`Self::evaluate`] with `∂R/∂x` factored by its structure ([`StructuredJacobian`])
+    /// instead of written dense, for [`Self::solve_factored`]: the Newton systems of many
+    /// contact directions, whose dense LU would be the whole cost. `Ok(false)` if the
+    /// factorisation is singular.
+    pub fn evaluate_factored(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        level: f64,
+        residual: &mut [f64],
+        domega: Option<&mut [f64]>,
+        dlevel: Option<&mut [f64]>,
+    ) -> Result<bool, HbmError> {
+        self.factored = None;
+        self.residual(x, omega, level, residual, true)?;
+        self.parameter_derivatives(level, domega, dlevel);
+        self.factored =
+            StructuredJacobian::factor(self.q, &self.h0, &self.harmonic, &self.joints.offsets, &self.joints.elem_jac);
+        Ok(self.factored.is_some())
+    }
+
+    /// Overwrite `b` with `(∂R/∂x)⁻¹ b` at the point of the last [`Self::evaluate_factored`];
+    /// false if there is none or the result is not finite.
+    pub fn solve_factored(&mut self, b: &mut [f64]) -> bool {
+        self.factored.as_mut().is_some_and(|f| f.solve(b))
+    }
+
+    /// Are the Newton systems solved by their structure ([`Self::evaluate_factored`]) in
+    /// sweeps? By default from [`FACTOR_BY_STRUCTURE_FROM`] unknowns.
+    pub fn factors_by_structure(&self) -> bool {
+        self.by_structure
+    }
+
+    /// Choose how sweeps solve the Newton systems: by structure or by a dense LU.
+    pub fn set_factor_by_structure(&mut self, by_structure: bool) {
+        self.by_structure = by_structure;
+    }
+
+    /// The factored Jacobian of the last [`Self::evaluate_factored`].
+    pub fn structured_jacobian(&self) -> Option<&StructuredJacobian> {
+        self.factored.as_ref()
+    }
+
+    fn assemble_jacobian(&mut self, mut dx: MatMut<'_, f64>, nc: usize) {
         let q = self.q;
-        let Jacobians { mut dx, domega, dlevel } = jac;
         // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
         // depends on its own directions only), so column (c2, off+b) of element e only meets
         // the columns off..off+d of H: O(q nc² d²) per element instead of O(q³ nc²).
@@ -256,6 +342,11 @@ impl<'m> CondensedHbm<'m> {
                 }
             }
         }
+    }
+
+    /// `∂R/∂Ω` and `∂R/∂λ_F`, as asked, after an evaluation that computed `∂G/∂Ω`.
+    fn parameter_derivatives(&mut self, level: f64, domega: Option<&mut [f64]>, dlevel: Option<&mut [f64]>) {
+        let q = self.q;
         // ∂R/∂Ω = −λ_F ∂u_F/∂Ω + ∂H/∂Ω G + H ∂G/∂Ω, with ∂H_k/∂Ω = k H'(kΩ).
         if let Some(dw) = domega {
             for i in 0..q {
@@ -263,25 +354,30 @@ impl<'m> CondensedHbm<'m> {
             }
             for k in 1..=self.plan.n_harmonics() {
                 let hr = &self.harmonic[k - 1];
-                let kf = k as f64;
                 let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+                let (g, dg) = (&self.joints.g, &self.joints.dg_domega);
+                // k dH/dω(kΩ) G_k ...
+                for (j, a) in self.amplitudes.iter_mut().enumerate() {
+                    *a = c64::new(g[ic + j], -g[is + j]);
+                }
+                self.receptance.apply_derivative(hr, &self.amplitudes, &mut self.product);
                 for i in 0..q {
-                    let mut vc = 0.0;
-                    let mut vs = 0.0;
+                    let v = self.product[i] * k as f64;
+                    dw[ic + i] = v.re;
+                    dw[is + i] = -v.im;
+                }
+                // ... + H_k ∂G_k/∂Ω − λ_F ∂u_F/∂Ω δ_k1.
+                for (j, a) in self.amplitudes.iter_mut().enumerate() {
+                    *a = c64::new(dg[ic + j], -dg[is + j]);
+                }
+                self.receptance.apply(hr, &self.amplitudes, &mut self.product);
+                for i in 0..q {
+                    dw[ic + i] += self.product[i].re;
+                    dw[is + i] -= self.product[i].im;
                     if k == 1 {
-                        vc -= level * hr.du_force[i].re;
-                        vs += level * hr.du_force[i].im;
+                        dw[ic + i] -= level * hr.du_force[i].re;
+                        dw[is + i] += level * hr.du_force[i].im;
                     }
-                    for j in 0..q {
-                        let dh = hr.dh[(i, j)] * kf;
-                        let h = hr.h[(i, j)];
-                        let (gc, gs) = (self.joints.g[ic + j], self.joints.g[is + j]);
-                        let (dgc, dgs) = (self.joints.dg_domega[ic + j], self.joints.dg_domega[is + j]);
-                        vc += dh.re * gc + dh.im * gs + h.re * dgc + h.im * dgs;
-                        vs += -dh.im * gc + dh.re * gs - h.im * dgc + h.re * dgs;
-                    }
-                    dw[ic + i] = vc;
-                    dw[is + i] = vs;
                 }
             }
         }

@@ -8,6 +8,7 @@ pub mod joint_forces;
 pub mod nonlinear_mode;
 pub mod receptance;
 pub mod stability;
+pub mod structured;
 pub mod sweep;
 
 pub use bifurcation::{bifurcations, stability_at, Bifurcation, BifurcationKind, BranchStabilityError};

@@ -16,12 +16,12 @@
 //! Two ways to evaluate it:
 //! - **Modal** (proportional or modal damping): with mass-normalised modes,
 //!   `Z⁻¹ = Σ_r φ_r φ_rᵀ / (ω_r² − ω² + iω c_r)`, exact when every mode is kept, and cheap:
-//!   O(q² m) per harmonic, whatever the model size.
+//!   O(q m) per harmonic for a residual and O(q² m) for the matrix, whatever the model size.
 //! - **Direct** (a general damping matrix): one complex LU of `Z(ω)` per harmonic and frequency.
 //!
 //! Physical DOFs are recovered afterwards (Eq. 27) from the same representation.
 
-use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Accum, Mat, MatRef, Par};
 
@@ -43,10 +43,6 @@ pub struct ModalReceptance {
     a: Mat<f64>,
     /// `b = Φᵀ F` (m).
     b: Vec<f64>,
-    /// `table[(i q + j, r)] = A_ir A_jr` for the receptance and `table[(q² + i, r)] = A_ir b_r`
-    /// for the excitation response: every harmonic is then one product of this table with the
-    /// modal weights `1/den_r` and their derivatives.
-    table: Mat<f64>,
     modes: Modes,
 }
 
@@ -63,30 +59,39 @@ pub struct DirectReceptance {
 #[derive(Clone, Debug)]
 pub struct Outputs(Vec<Vec<f64>>);
 
-/// Complex receptance of one harmonic and its derivative with respect to ω.
+/// The receptance at one harmonic frequency ω: `u_F(ω)` and its ω-derivative always, the q × q
+/// matrix `H(ω)` when asked ([`Receptance::evaluate_matrix`]), and products of `H` and `dH/dω`
+/// with force amplitudes ([`Receptance::apply`], [`Receptance::apply_derivative`]). A residual
+/// needs only the products (O(q m) with m modes); the matrix (O(q² m)) is for a Jacobian.
 pub struct HarmonicReceptance {
-    /// `H` (q × q).
+    /// `H` (q × q), symmetric; up to date after [`Receptance::evaluate_matrix`] only.
     pub h: Mat<c64>,
-    pub dh: Mat<c64>,
     /// `u_F` (q).
     pub u_force: Vec<c64>,
     pub du_force: Vec<c64>,
-    /// Modal weights (m × 4: Re, Im of 1/den and of its derivative) and their product with the
-    /// modal table ((q² + q) × 4), reused from call to call.
-    weights: Mat<f64>,
-    product: Mat<f64>,
+    /// Modal: `1/den_r` and `d(1/den_r)/dω` of every mode.
+    inverse: Vec<c64>,
+    inverse_derivative: Vec<c64>,
+    /// Modal: `A diag(Re 1/den)` and `A diag(Im 1/den)` (q × m), and the real and imaginary
+    /// parts of `H` (lower triangles), reused from call to call.
+    scaled: [Mat<f64>; 2],
+    parts: [Mat<f64>; 2],
+    /// Direct: `dH/dω` (q × q).
+    dh: Mat<c64>,
 }
 
 impl HarmonicReceptance {
-    /// Buffers for `q` directions (sized for the modal table at the first evaluation).
+    /// Buffers for `q` directions (sized for the model at the first evaluation).
     pub fn new(q: usize) -> Self {
         HarmonicReceptance {
             h: Mat::zeros(q, q),
-            dh: Mat::zeros(q, q),
             u_force: vec![c64::new(0.0, 0.0); q],
             du_force: vec![c64::new(0.0, 0.0); q],
-            weights: Mat::zeros(0, 4),
-            product: Mat::zeros(0, 4),
+            inverse: Vec::new(),
+            inverse_derivative: Vec::new(),
+            scaled: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
+            parts: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
+            dh: Mat::zeros(0, 0),
         }
     }
 }
@@ -103,16 +108,9 @@ impl Receptance {
             let phi = &modes.shapes;
             let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
             let b: Vec<f64> = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
-            let table = Mat::from_fn(q * q + q, m, |row, r| {
-                if row < q * q {
-                    a[(row / q, r)] * a[(row % q, r)]
-                } else {
-                    a[(row - q * q, r)] * b[r]
-                }
-            });
             let c_r =
                 modes.omega.iter().enumerate().map(|(r, &w)| model.damping.modal_coefficient(r, w).unwrap()).collect();
-            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, table, modes }))
+            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, modes }))
         } else {
             // Check M > 0 and K > 0 the same way as the modal path, so both fail alike.
             model.dense_modes()?;
@@ -135,11 +133,36 @@ impl Receptance {
         }
     }
 
-    /// `H(ω)`, `u_F(ω)` and their ω-derivatives into `out`.
+    /// `u_F(ω)`, its ω-derivative and what [`Self::apply`] and [`Self::apply_derivative`] need,
+    /// into `out` (the matrix `H` is left as it was).
     pub fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
         match self {
-            Receptance::Modal(m) => m.evaluate(omega, out),
+            Receptance::Modal(m) => m.evaluate(omega, out, false),
             Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
+    /// [`Self::evaluate`] and the matrix `H(ω)` (q × q) into `out.h`.
+    pub fn evaluate_matrix(&self, omega: f64, out: &mut HarmonicReceptance) {
+        match self {
+            Receptance::Modal(m) => m.evaluate(omega, out, true),
+            Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
+    /// `H(ω) g` for complex force amplitudes `g` (q), with `hr` from an evaluation at ω.
+    pub fn apply(&self, hr: &HarmonicReceptance, g: &[c64], out: &mut [c64]) {
+        match self {
+            Receptance::Modal(m) => m.apply(&hr.inverse, g, out),
+            Receptance::Direct(_) => multiply(&hr.h, g, out),
+        }
+    }
+
+    /// `dH/dω (ω) g`, with `hr` from an evaluation at ω.
+    pub fn apply_derivative(&self, hr: &HarmonicReceptance, g: &[c64], out: &mut [c64]) {
+        match self {
+            Receptance::Modal(m) => m.apply(&hr.inverse_derivative, g, out),
+            Receptance::Direct(_) => multiply(&hr.dh, g, out),
         }
     }
 
@@ -195,34 +218,80 @@ impl ModalReceptance {
         &self.modes
     }
 
-    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
-        let q = self.a.nrows();
-        let m = self.omega_r.len();
-        if out.weights.nrows() != m {
-            out.weights = Mat::zeros(m, 4);
-            out.product = Mat::zeros(q * q + q, 4);
-        }
+    /// The modal weights `1/den_r` and their ω-derivatives, `u_F` (O(q m)) and, with `matrix`,
+    /// `H = A diag(1/den) Aᵀ`: two real symmetric products (lower triangles), O(q² m) on a
+    /// q × m participation matrix that stays in cache.
+    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance, matrix: bool) {
+        let (q, m) = (self.a.nrows(), self.omega_r.len());
+        out.inverse.resize(m, c64::new(0.0, 0.0));
+        out.inverse_derivative.resize(m, c64::new(0.0, 0.0));
         for r in 0..m {
             let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
             let inv = den.inv();
+            out.inverse[r] = inv;
             // d(1/den)/dω = −(−2ω + i c_r)/den² = (2ω − i c_r)/den².
-            let dinv = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
-            out.weights[(r, 0)] = inv.re;
-            out.weights[(r, 1)] = inv.im;
-            out.weights[(r, 2)] = dinv.re;
-            out.weights[(r, 3)] = dinv.im;
+            out.inverse_derivative[r] = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
         }
-        matmul(out.product.as_mut(), Accum::Replace, self.table.as_ref(), out.weights.as_ref(), 1.0, Par::Seq);
-        let p = &out.product;
         for i in 0..q {
-            for j in 0..q {
-                let row = i * q + j;
-                out.h[(i, j)] = c64::new(p[(row, 0)], p[(row, 1)]);
-                out.dh[(i, j)] = c64::new(p[(row, 2)], p[(row, 3)]);
+            let (mut u, mut du) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
+            for r in 0..m {
+                let ab = self.a[(i, r)] * self.b[r];
+                u += out.inverse[r] * ab;
+                du += out.inverse_derivative[r] * ab;
             }
-            let row = q * q + i;
-            out.u_force[i] = c64::new(p[(row, 0)], p[(row, 1)]);
-            out.du_force[i] = c64::new(p[(row, 2)], p[(row, 3)]);
+            out.u_force[i] = u;
+            out.du_force[i] = du;
+        }
+        if !matrix {
+            return;
+        }
+        if out.scaled[0].nrows() != q || out.scaled[0].ncols() != m {
+            out.scaled = [Mat::zeros(q, m), Mat::zeros(q, m)];
+            out.parts = [Mat::zeros(q, q), Mat::zeros(q, q)];
+        }
+        for part in 0..2 {
+            let scaled = &mut out.scaled[part];
+            for r in 0..m {
+                let w = if part == 0 { out.inverse[r].re } else { out.inverse[r].im };
+                for i in 0..q {
+                    scaled[(i, r)] = self.a[(i, r)] * w;
+                }
+            }
+            triangular::matmul(
+                out.parts[part].as_mut(),
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                out.scaled[part].as_ref(),
+                BlockStructure::Rectangular,
+                self.a.transpose(),
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+        }
+        let [re, im] = &out.parts;
+        for j in 0..q {
+            for i in j..q {
+                let v = c64::new(re[(i, j)], im[(i, j)]);
+                out.h[(i, j)] = v;
+                out.h[(j, i)] = v;
+            }
+        }
+    }
+
+    /// `A diag(weights) Aᵀ g`: a receptance-like product in O(q m).
+    fn apply(&self, weights: &[c64], g: &[c64], out: &mut [c64]) {
+        let (q, m) = (self.a.nrows(), self.omega_r.len());
+        out.iter_mut().for_each(|v| *v = c64::new(0.0, 0.0));
+        for r in 0..m {
+            let mut t = c64::new(0.0, 0.0);
+            for j in 0..q {
+                t += g[j] * self.a[(j, r)];
+            }
+            let t = t * weights[r];
+            for i in 0..q {
+                out[i] += t * self.a[(i, r)];
+            }
         }
     }
 
@@ -264,6 +333,9 @@ impl DirectReceptance {
         // Z' = −2ωM + iD; by symmetry of Z, Vᵀ Z⁻¹ Z' Z⁻¹ W = Y_Vᵀ Z' Y_W.
         let zp = Mat::from_fn(n, n, |i, j| c64::new(-2.0 * omega * self.mass[(i, j)], self.damping[(i, j)]));
         let zpy = &zp * &y;
+        if out.dh.nrows() != q {
+            out.dh = Mat::zeros(q, q);
+        }
         for i in 0..q {
             for j in 0..=q {
                 let mut v = c64::new(0.0, 0.0);
@@ -302,5 +374,12 @@ impl DirectReceptance {
             }
         }
         (amps, dissipation)
+    }
+}
+
+/// `h g` for a dense complex matrix.
+fn multiply(h: &Mat<c64>, g: &[c64], out: &mut [c64]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = (0..g.len()).map(|j| h[(i, j)] * g[j]).sum();
     }
 }

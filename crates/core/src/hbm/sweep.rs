@@ -6,7 +6,8 @@ use faer::MatMut;
 
 use super::condensed::{CondensedHbm, HbmError, Jacobians};
 use crate::continuation::{
-    continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError, Silent, TerminationReason,
+    continue_branch, Branch, ContinuationError, FactoredJacobian, Observer, Options, Problem, ProblemError, Silent,
+    TerminationReason,
 };
 
 /// A sweep that could not start (a failure during the sweep is a termination reason of the
@@ -48,6 +49,30 @@ impl Problem for FrequencySweep<'_, '_> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: Some(dl), dlevel: None });
         self.hbm.evaluate(x, omega, self.level, residual, jac).map_err(problem_error)
     }
+
+    fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
+        if self.hbm.factors_by_structure() {
+            Some(self)
+        } else {
+            None
+        }
+    }
+}
+
+impl FactoredJacobian for FrequencySweep<'_, '_> {
+    fn evaluate_and_factor(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        residual: &mut [f64],
+        dr_domega: &mut [f64],
+    ) -> Result<bool, ProblemError> {
+        self.hbm.evaluate_factored(x, omega, self.level, residual, Some(dr_domega), None).map_err(problem_error)
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) -> bool {
+        self.hbm.solve_factored(rhs)
+    }
 }
 
 impl Problem for LevelSweep<'_, '_> {
@@ -64,6 +89,30 @@ impl Problem for LevelSweep<'_, '_> {
     ) -> Result<(), ProblemError> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: None, dlevel: Some(dl) });
         self.hbm.evaluate(x, self.omega, level, residual, jac).map_err(problem_error)
+    }
+
+    fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
+        if self.hbm.factors_by_structure() {
+            Some(self)
+        } else {
+            None
+        }
+    }
+}
+
+impl FactoredJacobian for LevelSweep<'_, '_> {
+    fn evaluate_and_factor(
+        &mut self,
+        x: &[f64],
+        level: f64,
+        residual: &mut [f64],
+        dr_dlevel: &mut [f64],
+    ) -> Result<bool, ProblemError> {
+        self.hbm.evaluate_factored(x, self.omega, level, residual, None, Some(dr_dlevel)).map_err(problem_error)
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) -> bool {
+        self.hbm.solve_factored(rhs)
     }
 }
 
