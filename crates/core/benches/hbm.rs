@@ -122,13 +122,49 @@ fn newton_iteration_contact_seconds(c: usize, harmonics: usize, runs: usize) -> 
     (median(eval), median(solve))
 }
 
+/// One Newton iteration on the patch at the linear response of `level` at 340 Hz: residual,
+/// Jacobian factored by structure and solved (median of `runs`), the same with the dense LU
+/// (once, skipped in `quick` runs), and the number of directions that couple harmonics.
+fn patch_newton_iteration(
+    model: &NonlinearModel,
+    force: &[f64],
+    level: f64,
+    quick: bool,
+    runs: usize,
+) -> (f64, Option<f64>, usize) {
+    let mut hbm = CondensedHbm::new(model, force, HbmSettings { harmonics: 7, samples: 300 }).unwrap();
+    let dim = hbm.dimension();
+    let omega = TWO_PI * 340.0;
+    let x = hbm.linear_solution(omega, level);
+    let mut r = vec![0.0; dim];
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        let t = Instant::now();
+        hbm.evaluate_factored(&x, omega, level, &mut r, None, None).unwrap();
+        assert!(hbm.solve_factored(&mut r));
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let coupled = hbm.structured_jacobian().unwrap().coupled_directions();
+    let dense = (!quick).then(|| {
+        let t = Instant::now();
+        let mut jac = Mat::zeros(dim, dim);
+        hbm.evaluate(&x, omega, level, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))
+            .unwrap();
+        std::hint::black_box(jac.partial_piv_lu().solve(Mat::from_fn(dim, 1, |i, _| r[i])));
+        t.elapsed().as_secs_f64()
+    });
+    (median(times), dense, coupled)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "quick");
-    // Optional filters: `table6`, `paper`, `cost`, `contact`, `stability` (default: all).
+    // Optional filters: `table6`, `paper`, `cost`, `contact`, `stability`, `patch` (default: all).
     let wanted = |name: &str| {
-        let filters: Vec<&String> =
-            args.iter().filter(|a| ["table6", "paper", "cost", "contact", "stability"].contains(&a.as_str())).collect();
+        let filters: Vec<&String> = args
+            .iter()
+            .filter(|a| ["table6", "paper", "cost", "contact", "stability", "patch"].contains(&a.as_str()))
+            .collect();
         filters.is_empty() || filters.iter().any(|f| *f == name)
     };
     let runs = if quick { 3 } else { 11 };
@@ -209,6 +245,38 @@ fn main() {
                     l * 1e3
                 );
             }
+        }
+    }
+    if wanted("patch") {
+        // A 10 × 10 patch of 3-D contacts (q = 300), N = 7: one Newton iteration solved by
+        // structure at levels where more and more of the patch slips, against the dense LU;
+        // then whole sweeps through the patch's resonance.
+        println!("contact patch 10 x 10 (q = 300), N = 7, 300 samples: one Newton iteration at 340 Hz");
+        let (model, force) = common::contact_patch(10);
+        for &level in &[100.0, 2000.0, 6000.0, 20000.0, 100000.0] {
+            let (structured, dense, coupled) = patch_newton_iteration(&model, &force, level, quick, runs.min(5));
+            println!(
+                "  linear response of {level:>6} N: {coupled:>3} of 300 directions slip or open; by structure \
+                 {:>8.1} ms, dense {}",
+                structured * 1e3,
+                dense.map_or("not run".into(), |d| format!("{:.1} ms", d * 1e3)),
+            );
+        }
+        for &level in &[200.0, 1000.0, 3000.0] {
+            let start = Instant::now();
+            let mut hbm = CondensedHbm::new(&model, &force, HbmSettings { harmonics: 7, samples: 300 }).unwrap();
+            let branch =
+                sweep_frequency(&mut hbm, level, TWO_PI * 250.0, TWO_PI * 450.0, &options, &mut Silent).unwrap();
+            let iterations: usize = branch.points.iter().map(|p| p.iterations).sum();
+            let seconds = start.elapsed().as_secs_f64();
+            println!(
+                "  sweep 250-450 Hz at {level:>5} N: {:>6.2} s, {} points, {} Newton iterations ({:.0} ms each){}",
+                seconds,
+                branch.points.len(),
+                iterations,
+                seconds * 1e3 / iterations.max(1) as f64,
+                if branch.termination == TerminationReason::ReachedEnd { "" } else { " (did not reach the end)" }
+            );
         }
     }
     if !wanted("cost") {
