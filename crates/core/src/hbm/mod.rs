@@ -1,5 +1,6 @@
 //! Harmonic balance (paper Section 4.1-4.2).
 pub mod condensed;
+pub mod dlft;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
