@@ -173,35 +173,51 @@ fn penalty_contact_converges_to_collocated_dlft_as_one_over_its_stiffness() {
 #[test]
 fn dlft_jacobian_matches_central_differences() {
     // Collocated and oversampled, at the solution and at a point off it (scaled by 1.3, where
-    // the residual does not vanish): central differences with a step 1e-7 of ‖x‖, whose
-    // truncation error vanishes on this piecewise linear-and-smooth residual unless a sample
-    // switches state within the step, and whose round-off is ~1e-16/1e-7 ≈ 1e-9 of the
-    // entries (measured 1e-9 to 4e-9 of the largest entry); asserted 1e-6 of the largest entry.
+    // the residual does not vanish): ∂R/∂x, ∂R/∂Ω and ∂R/∂λ_F against central differences
+    // with steps 1e-7 of ‖x‖, Ω and λ_F. Their truncation error vanishes on this piecewise
+    // linear-and-smooth residual unless a sample switches state within the step, and their
+    // round-off is ~1e-16/1e-7 ≈ 1e-9 of the entries (measured: 2e-9 to 3e-9 of the largest
+    // entry for ∂R/∂x, 6e-9 to 2e-8 for ∂R/∂Ω, 1e-9 for ∂R/∂λ_F); asserted 1e-6 of the
+    // largest entry of each derivative.
     let lin = dynamic_model();
     for settings in [collocated(7), HbmSettings { harmonics: 7, samples: 256 }] {
         let (mut dlft, x) = solve_dlft(&lin, settings, 0.5, None);
         let n = dlft.dimension();
         for point in [x.clone(), x.iter().map(|v| 1.3 * v).collect()] {
             let mut residual = vec![0.0; n];
-            let mut jacobian = Mat::zeros(n, n);
-            dlft.evaluate(&point, OMEGA, 1.0, &mut residual, Some(&mut jacobian)).unwrap();
-            let step = 1e-7 * norm(&point);
+            let mut dx = Mat::zeros(n, n);
+            let (mut domega, mut dlevel) = (vec![0.0; n], vec![0.0; n]);
+            let jacobians = Jacobians { dx: dx.as_mut(), domega: Some(&mut domega), dlevel: Some(&mut dlevel) };
+            dlft.evaluate(&point, OMEGA, 1.0, &mut residual, Some(jacobians)).unwrap();
             let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
-            let (mut worst, mut largest) = (0.0f64, 0.0f64);
-            for j in 0..n {
-                let mut shifted = point.clone();
-                shifted[j] += step;
-                dlft.evaluate(&shifted, OMEGA, 1.0, &mut plus, None).unwrap();
-                shifted[j] -= 2.0 * step;
-                dlft.evaluate(&shifted, OMEGA, 1.0, &mut minus, None).unwrap();
-                for i in 0..n {
-                    let fd = (plus[i] - minus[i]) / (2.0 * step);
-                    worst = worst.max((fd - jacobian[(i, j)]).abs());
-                    largest = largest.max(jacobian[(i, j)].abs());
+            let mut check = |what: &str,
+                             analytic: &dyn Fn(usize, usize) -> f64,
+                             columns: usize,
+                             shift: &dyn Fn(usize, f64) -> (Vec<f64>, f64, f64),
+                             step: f64| {
+                let (mut worst, mut largest) = (0.0f64, 0.0f64);
+                for j in 0..columns {
+                    let (xp, op, lp) = shift(j, step);
+                    dlft.evaluate(&xp, op, lp, &mut plus, None).unwrap();
+                    let (xm, om, lm) = shift(j, -step);
+                    dlft.evaluate(&xm, om, lm, &mut minus, None).unwrap();
+                    for i in 0..n {
+                        let fd = (plus[i] - minus[i]) / (2.0 * step);
+                        worst = worst.max((fd - analytic(i, j)).abs());
+                        largest = largest.max(analytic(i, j).abs());
+                    }
                 }
-            }
-            println!("{} samples: max |J − J_fd| = {worst:.2e}, max |J| = {largest:.2e}", settings.samples);
-            assert!(worst < 1e-6 * largest, "{} samples: {worst:.2e} vs {largest:.2e}", settings.samples);
+                println!("{} samples, {what}: max error {worst:.2e}, max entry {largest:.2e}", settings.samples);
+                assert!(worst < 1e-6 * largest, "{} samples, {what}: {worst:.2e} vs {largest:.2e}", settings.samples);
+            };
+            let shift_x = |j: usize, h: f64| {
+                let mut shifted = point.clone();
+                shifted[j] += h;
+                (shifted, OMEGA, 1.0)
+            };
+            check("∂R/∂x", &|i, j| dx[(i, j)], n, &shift_x, 1e-7 * norm(&point));
+            check("∂R/∂Ω", &|i, _| domega[i], 1, &|_, h| (point.clone(), OMEGA + h, 1.0), 1e-7 * OMEGA);
+            check("∂R/∂λ_F", &|i, _| dlevel[i], 1, &|_, h| (point.clone(), OMEGA, 1.0 + h), 1e-7);
         }
     }
 }

@@ -79,9 +79,9 @@
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
-use faer::{Accum, Mat, Par};
+use faer::{c64, Accum, Mat, Par};
 
-use super::condensed::{HbmError, HbmSettings};
+use super::condensed::{HbmError, HbmSettings, Jacobians};
 use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
@@ -111,13 +111,19 @@ pub struct DlftHbm {
     /// Frequency at which the per-harmonic matrices below were computed.
     omega: f64,
     harmonic: HarmonicReceptance,
-    /// `H` and `I − Z/ε` in the real coefficient-major layout, block diagonal per harmonic.
+    /// `H` and `B = I − Z/ε` in the real coefficient-major layout, block diagonal per
+    /// harmonic, and their derivatives with respect to Ω.
     h_real: Mat<f64>,
     b_real: Mat<f64>,
-    /// `u_F` of harmonic 1 in the real layout (cos, sin pair per direction).
+    dh_real: Mat<f64>,
+    db_real: Mat<f64>,
+    /// `u_F` of harmonic 1 in the real layout (cos, sin pair per direction), and `∂u_F/∂Ω`.
     u_force: Vec<f64>,
+    du_force: Vec<f64>,
     // Work buffers.
     y: Vec<f64>,
+    dy: Vec<f64>,
+    dlambda_domega: Vec<f64>,
     lambda: Vec<f64>,
     dlambda: Mat<f64>,
     hj: Mat<f64>,
@@ -193,8 +199,13 @@ impl DlftHbm {
             harmonic: HarmonicReceptance::new(q),
             h_real: Mat::zeros(dim, dim),
             b_real: Mat::zeros(dim, dim),
+            dh_real: Mat::zeros(dim, dim),
+            db_real: Mat::zeros(dim, dim),
             u_force: vec![0.0; dim],
+            du_force: vec![0.0; dim],
             y: vec![0.0; dim],
+            dy: vec![0.0; dim],
+            dlambda_domega: vec![0.0; dim],
             lambda: vec![0.0; dim],
             dlambda: Mat::zeros(dim, dim),
             hj: Mat::zeros(dim, dim),
@@ -239,67 +250,86 @@ impl DlftHbm {
         &self.afts[e]
     }
 
-    /// `H` and `I − Z/ε` per harmonic, in the real (cos, sin) layout of [`super::condensed`]:
-    /// a complex q×q block `A` acts on the pair `(c, s)` of amplitudes `c − i s` as
-    /// `[[Re A, Im A], [−Im A, Re A]]`.
+    /// `H`, `B = I − Z/ε` and their Ω-derivatives per harmonic, in the real (cos, sin) layout
+    /// of [`super::condensed`]: a complex q×q block `A` acts on the pair `(c, s)` of amplitudes
+    /// `c − i s` as `[[Re A, Im A], [−Im A, Re A]]`. Harmonic k sees `H(kΩ)`, so
+    /// `∂H_k/∂Ω = k H'(kΩ)`, and `∂Z/∂Ω = −Z (∂H/∂Ω) Z`.
     fn prepare(&mut self, omega: f64) {
         if omega == self.omega {
             return;
         }
-        let (q, nh) = (self.q, self.plan.n_harmonics());
-        self.h_real.fill(0.0);
-        self.b_real.fill(0.0);
-        self.u_force.iter_mut().for_each(|v| *v = 0.0);
-        // Harmonic 0: real.
+        let (q, nh, eps) = (self.q, self.plan.n_harmonics(), self.epsilon);
+        for m in [&mut self.h_real, &mut self.b_real, &mut self.dh_real, &mut self.db_real] {
+            m.fill(0.0);
+        }
+        self.u_force.iter_mut().chain(self.du_force.iter_mut()).for_each(|v| *v = 0.0);
+        let identity = |i: usize, j: usize| f64::from(u8::from(i == j));
+        // Harmonic 0: real, independent of Ω.
         self.receptance.evaluate(0.0, &mut self.harmonic);
         let h0 = Mat::from_fn(q, q, |i, j| self.harmonic.h[(i, j)].re);
         let z0 = h0.partial_piv_lu().inverse();
         for i in 0..q {
             for j in 0..q {
                 self.h_real[(i, j)] = h0[(i, j)];
-                self.b_real[(i, j)] = f64::from(u8::from(i == j)) - z0[(i, j)] / self.epsilon;
+                self.b_real[(i, j)] = identity(i, j) - z0[(i, j)] / eps;
             }
         }
         for k in 1..=nh {
             self.receptance.evaluate(k as f64 * omega, &mut self.harmonic);
-            let z = self.harmonic.h.partial_piv_lu().inverse();
+            let h = &self.harmonic.h;
+            let dh = Mat::from_fn(q, q, |i, j| self.harmonic.dh[(i, j)] * k as f64);
+            let z = h.partial_piv_lu().inverse();
+            // ∂B/∂Ω = −(∂Z/∂Ω)/ε = Z (∂H/∂Ω) Z / ε.
+            let db = &z * &dh * &z * faer::Scale(c64::new(1.0 / eps, 0.0));
             let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
             for i in 0..q {
                 for j in 0..q {
-                    let (h, zz) = (self.harmonic.h[(i, j)], z[(i, j)]);
-                    let d = f64::from(u8::from(i == j));
-                    self.h_real[(ic + i, ic + j)] = h.re;
-                    self.h_real[(ic + i, is + j)] = h.im;
-                    self.h_real[(is + i, ic + j)] = -h.im;
-                    self.h_real[(is + i, is + j)] = h.re;
-                    self.b_real[(ic + i, ic + j)] = d - zz.re / self.epsilon;
-                    self.b_real[(ic + i, is + j)] = -zz.im / self.epsilon;
-                    self.b_real[(is + i, ic + j)] = zz.im / self.epsilon;
-                    self.b_real[(is + i, is + j)] = d - zz.re / self.epsilon;
+                    let b = c64::new(identity(i, j), 0.0) - z[(i, j)] / eps;
+                    for (target, a) in [
+                        (&mut self.h_real, h[(i, j)]),
+                        (&mut self.b_real, b),
+                        (&mut self.dh_real, dh[(i, j)]),
+                        (&mut self.db_real, db[(i, j)]),
+                    ] {
+                        target[(ic + i, ic + j)] = a.re;
+                        target[(ic + i, is + j)] = a.im;
+                        target[(is + i, ic + j)] = -a.im;
+                        target[(is + i, is + j)] = a.re;
+                    }
                 }
                 if k == 1 {
-                    self.u_force[ic + i] = self.harmonic.u_force[i].re;
-                    self.u_force[is + i] = -self.harmonic.u_force[i].im;
+                    let (u, du) = (self.harmonic.u_force[i], self.harmonic.du_force[i]);
+                    self.u_force[ic + i] = u.re;
+                    self.u_force[is + i] = -u.im;
+                    self.du_force[ic + i] = du.re;
+                    self.du_force[is + i] = -du.im;
                 }
             }
         }
         self.omega = omega;
     }
 
-    /// Residual `R(x) = x − λ_F u_F + H λ(x)` and, if asked, `∂R/∂x`.
+    /// Residual `R(x) = x − λ_F u_F + H λ(y(x))` and, if asked, its derivatives:
+    ///
+    /// ```text
+    /// y       = B x + (I − B) λ_F u_F                       (B = I − Z/ε)
+    /// ∂R/∂x   = I + H (∂λ/∂y) B
+    /// ∂R/∂λ_F = −u_F + H (∂λ/∂y)(I − B) u_F
+    /// ∂R/∂Ω   = −λ_F ∂u_F/∂Ω + (∂H/∂Ω) λ + H [(∂λ/∂y) ∂y/∂Ω + ∂λ/∂Ω|_y],
+    /// ∂y/∂Ω   = (∂B/∂Ω)(x − λ_F u_F) + (I − B) λ_F ∂u_F/∂Ω.
+    /// ```
     pub fn evaluate(
         &mut self,
         x: &[f64],
         omega: f64,
         level: f64,
         residual: &mut [f64],
-        jacobian: Option<&mut Mat<f64>>,
+        jacobians: Option<Jacobians<'_>>,
     ) -> Result<(), HbmError> {
         self.prepare(omega);
         let (q, nc, n) = (self.q, self.plan.n_coeffs(), self.dimension());
-        let want = jacobian.is_some();
-        // y = x + g_lin/ε = x + (Z/ε)(λ_F u_F − x) = (I − Z/ε) x + (Z/ε) λ_F u_F
-        //   = B x + (I − B) λ_F u_F.
+        let want = jacobians.is_some();
+        // y = B (x − λ_F u_F) + λ_F u_F.
         for i in 0..n {
             let mut v = 0.0;
             for j in 0..n {
@@ -328,6 +358,7 @@ impl DlftHbm {
                 for a in 0..d {
                     self.lambda[c * q + off + a] = self.elem_g[e][c * d + a];
                     if want {
+                        self.dlambda_domega[c * q + off + a] = self.elem_dw[e][c * d + a];
                         for c2 in 0..nc {
                             for b in 0..d {
                                 self.dlambda[(c * q + off + a, c2 * q + off + b)] =
@@ -339,27 +370,49 @@ impl DlftHbm {
             }
         }
         for i in 0..n {
-            let mut v = x[i] - level * self.u_force[i];
-            for j in 0..n {
-                v += self.h_real[(i, j)] * self.lambda[j];
-            }
-            residual[i] = v;
+            residual[i] = x[i] - level * self.u_force[i] + dot(self.h_real.row(i), &self.lambda);
         }
-        if let Some(jac) = jacobian {
-            // ∂R/∂x = I + H (∂λ/∂y) B.
-            matmul(self.hj.as_mut(), Accum::Replace, self.h_real.as_ref(), self.dlambda.as_ref(), 1.0, Par::Seq);
-            matmul(jac.as_mut(), Accum::Replace, self.hj.as_ref(), self.b_real.as_ref(), 1.0, Par::Seq);
+        let Some(jacobians) = jacobians else { return Ok(()) };
+        // H ∂λ/∂y, shared by the three derivatives.
+        matmul(self.hj.as_mut(), Accum::Replace, self.h_real.as_ref(), self.dlambda.as_ref(), 1.0, Par::Seq);
+        let mut dx = jacobians.dx;
+        matmul(dx.as_mut(), Accum::Replace, self.hj.as_ref(), self.b_real.as_ref(), 1.0, Par::Seq);
+        for i in 0..n {
+            dx[(i, i)] += 1.0;
+        }
+        if let Some(dlevel) = jacobians.dlevel {
+            // (I − B) u_F into dy, then −u_F + H (∂λ/∂y) dy.
             for i in 0..n {
-                jac[(i, i)] += 1.0;
+                self.dy[i] = self.u_force[i] - dot(self.b_real.row(i), &self.u_force);
+            }
+            for i in 0..n {
+                dlevel[i] = -self.u_force[i] + dot(self.hj.row(i), &self.dy);
+            }
+        }
+        if let Some(domega) = jacobians.domega {
+            for i in 0..n {
+                let mut v = level * (self.du_force[i] - dot(self.b_real.row(i), &self.du_force));
+                for j in 0..n {
+                    v += self.db_real[(i, j)] * (x[j] - level * self.u_force[j]);
+                }
+                self.dy[i] = v;
+            }
+            for i in 0..n {
+                domega[i] = -level * self.du_force[i]
+                    + dot(self.dh_real.row(i), &self.lambda)
+                    + dot(self.hj.row(i), &self.dy)
+                    + dot(self.h_real.row(i), &self.dlambda_domega);
             }
         }
         Ok(())
     }
 
-    /// Newton's method at fixed (Ω, λ_F) from `x0` to `‖R‖ ≤ tolerance · ‖x‖`; the solution and
-    /// the number of iterations. The rigid contact makes `R` piecewise smooth with many more
-    /// kinks than a penalty law (every sample's stick/slip/open state switches on a hyperplane),
-    /// so a full step that increases `‖R‖` is halved (up to 8 times) before it is taken.
+    /// Newton's method at fixed (Ω, λ_F) from `x0` to `‖R‖ ≤ tolerance · max(‖x‖, λ_F ‖u_F‖)`
+    /// (the scale of a free response, so that a stuck contact's `x = 0` is reached); the
+    /// solution and the number of iterations. The rigid contact makes `R` piecewise smooth with
+    /// many more kinks than a penalty law (every sample's stick/slip/open state switches on a
+    /// hyperplane), so a full step that increases `‖R‖` is halved (up to 8 times) before it is
+    /// taken.
     pub fn solve(
         &mut self,
         omega: f64,
@@ -376,8 +429,9 @@ impl DlftHbm {
         let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
         let mut rel = f64::INFINITY;
         for it in 0..=max_iterations {
-            self.evaluate(&x, omega, level, &mut r, Some(&mut jac))?;
-            rel = norm(&r) / norm(&x).max(f64::MIN_POSITIVE);
+            self.evaluate(&x, omega, level, &mut r, Some(Jacobians { dx: jac.as_mut(), domega: None, dlevel: None }))?;
+            let scale = norm(&x).max(level.abs() * norm(&self.u_force)).max(f64::MIN_POSITIVE);
+            rel = norm(&r) / scale;
             if rel <= tolerance {
                 return Ok((x, it));
             }
@@ -406,6 +460,10 @@ impl DlftHbm {
             residual: rel,
         })
     }
+}
+
+fn dot(row: faer::RowRef<'_, f64>, v: &[f64]) -> f64 {
+    row.iter().zip(v).map(|(a, b)| a * b).sum()
 }
 
 fn law_dirs(law: &Contact) -> usize {
