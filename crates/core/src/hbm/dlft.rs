@@ -74,17 +74,19 @@
 //! (one quasi-static direction) `I − Z/ε` vanishes, the prediction is the external force and
 //! Newton converges in one step.
 //!
-//! Scope: a fixed (Ω, λ_F) Newton solve, dense matrices of size (2N+1)q (contacts are few
-//! here: a patch of many nodes would want the structured solvers of the penalty balance).
+//! Scope: a Newton solve at fixed (Ω, λ_F) ([`DlftHbm::solve`]) and continuation in Ω or λ_F
+//! ([`DlftFrequencySweep`], [`DlftLevelSweep`]); dense matrices of size (2N+1)q (contacts are
+//! few here: a patch of many nodes would want the structured solvers of the penalty balance).
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
-use faer::{c64, Accum, Mat, Par};
+use faer::{c64, Accum, Mat, MatMut, Par};
 
 use super::condensed::{HbmError, HbmSettings, Jacobians};
 use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
+use crate::continuation::{Problem, ProblemError, Scales};
 use crate::elements::{Contact, ElementError};
 use crate::model::{LinearModel, ModelError};
 
@@ -232,6 +234,14 @@ impl DlftHbm {
         receptance.evaluate(omega, &mut h);
         let z = h.h.partial_piv_lu().inverse();
         Ok((0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64)
+    }
+
+    /// `‖u_F(Ω)‖`: the contact directions' response to the force at unit level with the
+    /// contacts removed.
+    pub fn free_response_norm(&self, omega: f64) -> f64 {
+        let mut harmonic = HarmonicReceptance::new(self.q);
+        self.receptance.evaluate(omega, &mut harmonic);
+        harmonic.u_force.iter().map(|u| u.norm_sqr()).sum::<f64>().sqrt()
     }
 
     /// Number of unknowns (2N+1)q.
@@ -459,6 +469,69 @@ impl DlftHbm {
             iterations: max_iterations,
             residual: rel,
         })
+    }
+}
+
+/// Continuation in frequency of the DLFT balance at a fixed force level, for
+/// [`continue_branch`](crate::continuation::continue_branch) (`λ` is Ω, rad/s).
+pub struct DlftFrequencySweep<'a> {
+    pub dlft: &'a mut DlftHbm,
+    pub level: f64,
+}
+
+/// Continuation in force level of the DLFT balance at a fixed frequency (`λ` is λ_F).
+pub struct DlftLevelSweep<'a> {
+    pub dlft: &'a mut DlftHbm,
+    pub omega: f64,
+}
+
+impl Problem for DlftFrequencySweep<'_> {
+    fn dimension(&self) -> usize {
+        self.dlft.dimension()
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: Some(dl), dlevel: None });
+        self.dlft.evaluate(x, omega, self.level, residual, jac).map_err(problem_error)
+    }
+}
+
+impl Problem for DlftLevelSweep<'_> {
+    fn dimension(&self) -> usize {
+        self.dlft.dimension()
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        level: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: None, dlevel: Some(dl) });
+        self.dlft.evaluate(x, self.omega, level, residual, jac).map_err(problem_error)
+    }
+
+    /// Displacements and residuals on the scale of the free response at unit level: a sweep
+    /// that starts stuck has `x = 0` and a zero tangent there, which size nothing.
+    fn scales(&self) -> Scales {
+        let free = self.dlft.free_response_norm(self.omega);
+        Scales { unknowns: Some(free), residual: Some(free) }
+    }
+}
+
+/// A correction law without a periodic regime for a wild trial motion rejects the step (it is
+/// retried shorter), as in [`super::sweep`]; any other error ends the branch.
+fn problem_error(e: HbmError) -> ProblemError {
+    match e {
+        HbmError::Aft(_) => ProblemError::at_trial_iterate(e.to_string()),
+        _ => ProblemError::new(e.to_string()),
     }
 }
 
