@@ -34,8 +34,8 @@
 //! the return mapping of [`Contact`] with `k_t = k_n = ε` applied to the "displacement"
 //! `y = x + g_lin(x)/ε`: `N = max(0, N0 + ε y_n)`; stick keeps the slider `w` so that
 //! `T = ε (y_t − w)` grows by the increments of `ε y_t`; slip and separation move it. The
-//! periodic start of the stick force, the point Nacivet et al. settle by marching two periods,
-//! is the periodic regime of that law, found as for any hysteretic element
+//! starting value of the stick force (which DLFT implementations often settle by marching two
+//! periods) is the periodic regime of that law, found as for any hysteretic element
 //! ([`super::element_aft`]: from the last open sample, where the slider resets, or by
 //! marching periods until the state repeats). The DLFT force is the AFT of that law at `y(x)`,
 //! with its analytic Jacobian `∂λ/∂y`, and
@@ -46,8 +46,8 @@
 //!
 //! **Exact constraints need one sample per unknown.** At a solution the projection of `λ`
 //! equals `g_lin(x)`, so `ε x = P[λ_u − λ]` (P: the projection on N harmonics of the samples).
-//! With `n_t = 2N+1` samples P is invertible on trigonometric polynomials of degree N, so
-//! `λ(t_j) = g_lin(t_j)` and `ε x(t_j) = λ_u(t_j) − λ(t_j)` at every sample: zero where the
+//! With `n_t = 2N+1` samples, sampling and P are inverse one-to-one maps between the 2N+1
+//! coefficients and the 2N+1 samples, so `λ(t_j) = g_lin(t_j)` and `ε x(t_j) = λ_u(t_j) − λ(t_j)` at every sample: zero where the
 //! contact is closed (no penetration) and, tangentially, zero increment where it sticks (no
 //! slip between samples); where it is open, `x_n(t_j) < 0`. The constraints then hold exactly
 //! at the samples and the solution does not depend on ε (to round-off): this is the
@@ -79,9 +79,9 @@
 //! **Choice of ε.** ε sets how the prediction weighs the constraint against the linear force,
 //! hence the conditioning of (3) and Newton's path, not (collocated) the solution. Nacivet et
 //! al. take it of the order of the structure's stiffness seen by the contact;
-//! [`DlftHbm::default_epsilon`] is the mean of `|Z_ii(Ω)|` at harmonic 1. With `ε = Z` exactly
-//! (one quasi-static direction) `I − Z/ε` vanishes, the prediction is the external force and
-//! Newton converges in one step.
+//! [`DlftHbm::default_epsilon`] is the mean of `|Z_ii(Ω)|` at harmonic 1. For a quasi-static
+//! structure (`Z ≈ K` at every harmonic) with a diagonal `K = k I` and `ε = k`, `I − Z/ε`
+//! vanishes, the prediction is the external force and Newton converges in one step.
 //!
 //! Scope: a Newton solve at fixed (Ω, λ_F) ([`DlftHbm::solve`]) and continuation in Ω or λ_F
 //! ([`DlftFrequencySweep`], [`DlftLevelSweep`]); dense matrices of size (2N+1)q (contacts are
