@@ -339,8 +339,9 @@ fn damped_newton_at(hbm: &mut CondensedHbm<'_>, omega: f64, x0: &[f64]) -> Vec<f
 }
 
 /// Continuation through the DLFT balance: in force level from a stuck start (x = 0 at level
-/// 0.1: the contact slips from level 0.3125, where 40λ reaches μ(50 − 60λ) at cos Ωt = −1)
-/// up to level 1, then in frequency from 60 to 75 Hz (above, the sixth harmonic nears the
+/// 0.1; from level 0.3125, where 40λ reaches μ(50 − 60λ) at cos Ωt = −1, the contact slips in
+/// the first period and then sticks, up to the shakedown limit 0.5 where it starts slipping
+/// both ways every period; it opens from 0.83) up to level 1, then in frequency from 60 to 75 Hz (above, the sixth harmonic nears the
 /// 503 Hz mode of x: a super-harmonic resonance of a non-smooth system, left out here).
 #[test]
 fn continuation_in_level_and_frequency_stays_on_the_rigid_limit() {

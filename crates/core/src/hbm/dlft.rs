@@ -71,10 +71,14 @@
 //! between stick, slip and separation; Newton can cycle between such pieces. Measured on the
 //! 2-DOF test model (0.1 kg and 0.01 kg on 1e6 N/m, 60 Hz), continuation in force level from
 //! the stuck state ([`DlftLevelSweep`]) reaches level 1 with the collocated form at N = 7 but
-//! stops (Newton cycling) near level 0.5 at N = 15 and 31, where the oversampled form (512
-//! samples) passes at N = 7, 15 and 31. The penalty contact at k ≥ 1e8 N/m stops at the
-//! onset of slip (level 0.31) with either sampling. A cold Newton solve ([`DlftHbm::solve`])
-//! is less robust than the level continuation.
+//! stops (Newton cycling) at level 0.502 at N = 15 and 31, where the oversampled form (512
+//! samples) passes at N = 7, 15 and 31. Level 0.5 is that model's shakedown limit: from the
+//! onset of slip (0.3125) up to it, the contact slips during the first period only and then
+//! sticks (a continuum of stuck periodic solutions, the one computed fixed by the law's
+//! stuck-mean start); above it, it slips both ways every period, and the branch has a corner
+//! there. The penalty contact at k ≥ 1e8 N/m stops at the onset of slip (level 0.31) with
+//! either sampling. A cold Newton solve ([`DlftHbm::solve`]) is less robust than the level
+//! continuation.
 //!
 //! **Choice of ε.** ε sets how the prediction weighs the constraint against the linear force,
 //! hence the conditioning of (3) and Newton's path, not (collocated) the solution. Nacivet et
