@@ -290,7 +290,7 @@ fn dlft_converges_to_the_exact_quasi_static_cycle_as_harmonics_grow() {
     // kinks at the switches, harmonics decaying as 1/k², and the collocated contact force is
     // aliased); ε-spreads of the oversampled solution 2.7e-2, 1.05e-2, 3.3e-3. Asserted: each
     // doubling of N divides both by at least 1.8, and the N = 31 values stay below 4e-3 and
-    // 5e-3 (the 1.4 % inertia and the 2^16-sample reference are far below these).
+    // 5e-3 (the 1.4e-5 inertia and the 2^16-sample reference are far below these).
     for (name, values) in [("collocated error", &collocated_errors), ("oversampled ε-spread", &epsilon_spreads)] {
         for pair in values.windows(2) {
             assert!(pair[0] / pair[1] > 1.8, "{name} does not fall with N: {values:?}");
