@@ -1,6 +1,7 @@
 //! Harmonic balance (paper Section 4.1-4.2).
 pub mod bifurcation;
 pub mod condensed;
+pub mod dlft;
 pub mod element_aft;
 pub mod fourier;
 pub mod full;
