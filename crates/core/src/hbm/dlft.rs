@@ -244,7 +244,7 @@ impl DlftHbm {
         let receptance = Receptance::new(linear, &directions, force)?;
         let q = directions.len();
         let mut h = HarmonicReceptance::new(q);
-        receptance.evaluate(omega, &mut h);
+        receptance.evaluate_matrix(omega, &mut h);
         let z = h.h.partial_piv_lu().inverse();
         Ok((0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64)
     }
@@ -288,7 +288,7 @@ impl DlftHbm {
         self.u_force.iter_mut().chain(self.du_force.iter_mut()).for_each(|v| *v = 0.0);
         let identity = |i: usize, j: usize| f64::from(u8::from(i == j));
         // Harmonic 0: real, independent of Ω.
-        self.receptance.evaluate(0.0, &mut self.harmonic);
+        self.receptance.evaluate_matrix(0.0, &mut self.harmonic);
         let h0 = Mat::from_fn(q, q, |i, j| self.harmonic.h[(i, j)].re);
         let z0 = h0.partial_piv_lu().inverse();
         for i in 0..q {
@@ -298,9 +298,9 @@ impl DlftHbm {
             }
         }
         for k in 1..=nh {
-            self.receptance.evaluate(k as f64 * omega, &mut self.harmonic);
+            self.receptance.evaluate_matrix(k as f64 * omega, &mut self.harmonic);
             let h = &self.harmonic.h;
-            let dh = Mat::from_fn(q, q, |i, j| self.harmonic.dh[(i, j)] * k as f64);
+            let dh = self.receptance.derivative_matrix(&self.harmonic) * faer::Scale(c64::new(k as f64, 0.0));
             let z = h.partial_piv_lu().inverse();
             // ∂B/∂Ω = −(∂Z/∂Ω)/ε = Z (∂H/∂Ω) Z / ε.
             let db = &z * &dh * &z * faer::Scale(c64::new(1.0 / eps, 0.0));

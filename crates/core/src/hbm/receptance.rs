@@ -166,6 +166,20 @@ impl Receptance {
         }
     }
 
+    /// The matrix `dH/dω` (q × q) at the frequency of the evaluation into `hr`, for the
+    /// formulations that need it whole (O(q² m)).
+    pub fn derivative_matrix(&self, hr: &HarmonicReceptance) -> Mat<c64> {
+        match self {
+            Receptance::Modal(m) => {
+                let (q, a) = (m.a.nrows(), &m.a);
+                Mat::from_fn(q, q, |i, j| {
+                    (0..m.omega_r.len()).map(|r| hr.inverse_derivative[r] * (a[(i, r)] * a[(j, r)])).sum()
+                })
+            }
+            Receptance::Direct(_) => hr.dh.clone(),
+        }
+    }
+
     /// Prepare output selectors `o` (each of length n) for [`recover`](Self::recover): their
     /// modal projections `Φᵀ o` once, rather than at every harmonic of every point.
     pub fn outputs(&self, outputs: &[&[f64]]) -> Outputs {
