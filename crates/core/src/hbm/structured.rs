@@ -24,8 +24,8 @@
 //! `1e-10` of its largest entry (a stuck element's are round-off of the AFT); neglecting them
 //! changes the Newton step by as much, far below the continuation's tolerance.
 
-use faer::linalg::solvers::Solve;
-use faer::Mat;
+use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::{c64, Mat};
 
 use super::fourier::{cos_index, sin_index};
 use super::receptance::HarmonicReceptance;
@@ -38,57 +38,40 @@ fn harmonic_of(c: usize) -> usize {
     c.div_ceil(2)
 }
 
-/// Position of coefficient `c`, direction `i`, inside its harmonic's block (size q for the
-/// constant, 2q for k ≥ 1: cosines then sines).
-fn local(c: usize, i: usize, width: usize) -> usize {
-    if c > 0 && c % 2 == 0 {
-        width + i
+/// The coefficients of harmonic k: the constant, or its cosine and sine.
+fn coefficients(k: usize) -> Vec<usize> {
+    if k == 0 {
+        vec![0]
     } else {
-        i
+        vec![cos_index(k), sin_index(k)]
     }
 }
 
 /// The factored Jacobian `I + H B` of one iterate.
+///
+/// Per harmonic k the unknowns of the linear part are complex, `x_k = c − i s` (the layout of
+/// [`super::condensed`]): an invariant element's block is then the complex `K_cc + i K_cs`
+/// (its real form `[[K_cc, K_cs], [−K_cs, K_cc]]`), and `A_k` one complex q × q matrix.
 pub struct StructuredJacobian {
     q: usize,
     n_coeffs: usize,
-    /// LU of `A_k` per harmonic (k = 0..=N).
-    blocks: Vec<faer::linalg::solvers::PartialPivLu<f64>>,
-    /// The directions of the elements that couple harmonics, and for each element of N its
-    /// first direction in this list and its global offset.
+    /// LU of the complex `A_k` per harmonic (k = 0..=N).
+    blocks: Vec<PartialPivLu<c64>>,
+    /// The directions of the elements that couple harmonics.
     n_dirs: Vec<usize>,
-    n_elements: Vec<(usize, usize, usize)>,
-    /// `C_k = A_k⁻¹ H_k E_N` per harmonic.
-    coupling: Vec<Mat<f64>>,
+    /// For each element that couples harmonics: its first position in `n_dirs` and its block of
+    /// `B` ((2N+1) d square).
+    n_elements: Vec<(usize, Mat<f64>)>,
+    /// `C_k = A_k⁻¹ H_k E_N` per harmonic (complex q × q_N).
+    coupling: Vec<Mat<c64>>,
     /// LU of `M`, or `None` when every element is invariant.
-    reduced: Option<faer::linalg::solvers::PartialPivLu<f64>>,
-    /// Each element's block of `B` (for the elements of N).
-    element_jacobians: Vec<Mat<f64>>,
-    /// Scratch of size (2N+1) q_N.
-    reduced_rhs: Mat<f64>,
-}
-
-/// `H_k` in real form: the constant block `H(0)` (q × q), or `[[Re H, Im H], [−Im H, Re H]]`.
-fn real_block(k: usize, h0: &Mat<f64>, harmonic: &[HarmonicReceptance]) -> Mat<f64> {
-    if k == 0 {
-        return h0.clone();
-    }
-    let h = &harmonic[k - 1].h;
-    let q = h.nrows();
-    Mat::from_fn(2 * q, 2 * q, |i, j| {
-        let v = h[(i % q, j % q)];
-        match (i < q, j < q) {
-            (true, true) | (false, false) => v.re,
-            (true, false) => v.im,
-            (false, true) => -v.im,
-        }
-    })
+    reduced: Option<PartialPivLu<f64>>,
 }
 
 impl StructuredJacobian {
     /// Factor `I + H B` from the harmonic receptances (`h0` = H(0), `harmonic[k−1]` = H(kΩ)
     /// with its matrix evaluated) and the elements' blocks `element_jacobians` (element `e`
-    /// on directions `offsets[e]..offsets[e] + dims[e]`). `None` if a block is singular.
+    /// on directions `offsets[e]..`, `(2N+1) d` square). `None` if a factor is singular.
     pub fn factor(
         q: usize,
         h0: &Mat<f64>,
@@ -99,13 +82,12 @@ impl StructuredJacobian {
         let n_harmonics = harmonic.len();
         let nc = 2 * n_harmonics + 1;
         let dims: Vec<usize> = element_jacobians.iter().map(|j| j.nrows() / nc).collect();
-        let invariant: Vec<bool> =
-            element_jacobians.iter().zip(&dims).map(|(j, &d)| couples_no_harmonics(j, d)).collect();
+        let invariant: Vec<bool> = element_jacobians.iter().zip(&dims).map(|(j, &d)| is_invariant(j, d)).collect();
         let mut n_dirs = Vec::new();
         let mut n_elements = Vec::new();
         for (e, &inv) in invariant.iter().enumerate() {
             if !inv {
-                n_elements.push((e, n_dirs.len(), offsets[e]));
+                n_elements.push((n_dirs.len(), element_jacobians[e].clone()));
                 n_dirs.extend(offsets[e]..offsets[e] + dims[e]);
             }
         }
@@ -113,87 +95,41 @@ impl StructuredJacobian {
         let mut blocks = Vec::with_capacity(n_harmonics + 1);
         let mut coupling = Vec::with_capacity(n_harmonics + 1);
         for k in 0..=n_harmonics {
-            let hk = real_block(k, h0, harmonic);
-            let coeffs: Vec<usize> = if k == 0 { vec![0] } else { vec![cos_index(k), sin_index(k)] };
-            let size = hk.nrows();
-            // A_k = I + H_k B_L,k: each invariant element adds H_k's columns on its
-            // directions times its block within harmonic k.
-            let mut a = Mat::<f64>::identity(size, size);
+            let h = |i: usize, j: usize| if k == 0 { c64::new(h0[(i, j)], 0.0) } else { harmonic[k - 1].h[(i, j)] };
+            let (c, s) = if k == 0 { (0, 0) } else { (cos_index(k), sin_index(k)) };
+            // A_k = I + H_k B_L,k: each invariant element adds H_k's columns on its directions
+            // times its complex block.
+            let mut a = Mat::<c64>::identity(q, q);
             for (e, je) in element_jacobians.iter().enumerate() {
                 if !invariant[e] {
                     continue;
                 }
-                let d = dims[e];
-                for &c2 in &coeffs {
-                    for b in 0..d {
-                        let col = local(c2, offsets[e] + b, q);
-                        for &c1 in &coeffs {
-                            for a_dir in 0..d {
-                                let v = je[(c1 * d + a_dir, c2 * d + b)];
-                                if v != 0.0 {
-                                    let src = local(c1, offsets[e] + a_dir, q);
-                                    for i in 0..size {
-                                        a[(i, col)] += hk[(i, src)] * v;
-                                    }
-                                }
-                            }
+                let (d, off) = (dims[e], offsets[e]);
+                for col in 0..d {
+                    for row in 0..d {
+                        let re = je[(c * d + row, c * d + col)];
+                        let im = if k == 0 { 0.0 } else { je[(c * d + row, s * d + col)] };
+                        if re == 0.0 && im == 0.0 {
+                            continue;
+                        }
+                        let b = c64::new(re, im);
+                        for i in 0..q {
+                            a[(i, off + col)] += h(i, off + row) * b;
                         }
                     }
                 }
             }
             let lu = a.partial_piv_lu();
-            // C_k = A_k⁻¹ H_k E_N (columns of N's directions within harmonic k).
-            let cols: Vec<usize> = coeffs.iter().flat_map(|&c| n_dirs.iter().map(move |&i| local(c, i, q))).collect();
-            let hn = Mat::from_fn(size, cols.len(), |i, j| hk[(i, cols[j])]);
+            let hn = Mat::from_fn(q, qn, |i, j| h(i, n_dirs[j]));
             let ck = lu.solve(&hn);
-            if !ck.col_iter().all(|c| c.iter().all(|v| v.is_finite())) {
+            if !ck.col_iter().all(|c| c.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
                 return None;
             }
             blocks.push(lu);
             coupling.push(ck);
         }
-        // M = I + (E_Nᵀ C) B_N on the coefficient-major N unknowns c·q_N + j.
-        let reduced = (qn > 0).then(|| {
-            let mut m = Mat::<f64>::identity(nc * qn, nc * qn);
-            for &(e, first, _) in &n_elements {
-                let (je, d) = (&element_jacobians[e], dims[e]);
-                for c_col in 0..nc {
-                    for b in 0..d {
-                        let col = c_col * qn + first + b;
-                        for c2 in 0..nc {
-                            let k = harmonic_of(c2);
-                            let ck = &coupling[k];
-                            let rows: &[usize] = if k == 0 { &[0] } else { &[cos_index(k), sin_index(k)] };
-                            for a_dir in 0..d {
-                                let v = je[(c2 * d + a_dir, c_col * d + b)];
-                                if v == 0.0 {
-                                    continue;
-                                }
-                                let src = local(c2, first + a_dir, qn);
-                                for &c1 in rows {
-                                    for i in 0..qn {
-                                        let row = local(c1, n_dirs[i], q);
-                                        m[(c1 * qn + i, col)] += ck[(row, src)] * v;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            m.partial_piv_lu()
-        });
-        Some(StructuredJacobian {
-            q,
-            n_coeffs: nc,
-            blocks,
-            element_jacobians: n_elements.iter().map(|&(e, _, _)| element_jacobians[e].clone()).collect(),
-            n_dirs,
-            n_elements,
-            coupling,
-            reduced,
-            reduced_rhs: Mat::zeros(nc * qn, 1),
-        })
+        let reduced = (qn > 0).then(|| reduced_matrix(nc, &n_dirs, &n_elements, &coupling).partial_piv_lu());
+        Some(StructuredJacobian { q, n_coeffs: nc, blocks, n_dirs, n_elements, coupling, reduced })
     }
 
     /// Number of directions that couple harmonics at this iterate (q_N).
@@ -203,56 +139,109 @@ impl StructuredJacobian {
 
     /// Overwrite `b` ((2N+1) q, coefficient-major) with `J⁻¹ b`; false if the result is not
     /// finite.
-    pub fn solve(&mut self, b: &mut [f64]) -> bool {
+    pub fn solve(&self, b: &mut [f64]) -> bool {
         let (q, nc, qn) = (self.q, self.n_coeffs, self.n_dirs.len());
-        // w = A⁻¹ b, harmonic by harmonic.
+        // w = A⁻¹ b, harmonic by harmonic, in the complex form c − i s.
         for (k, lu) in self.blocks.iter().enumerate() {
-            let coeffs: &[usize] = if k == 0 { &[0] } else { &[cos_index(k), sin_index(k)] };
-            let size = coeffs.len() * q;
-            let rhs = Mat::from_fn(size, 1, |i, _| b[coeffs[i / q] * q + i % q]);
-            let w = lu.solve(&rhs);
-            for i in 0..size {
-                b[coeffs[i / q] * q + i % q] = w[(i, 0)];
+            let w = lu.solve(Mat::from_fn(q, 1, |i, _| complex_at(b, q, k, i)));
+            for i in 0..q {
+                set_complex(b, q, k, i, w[(i, 0)]);
             }
         }
-        if let Some(reduced) = &self.reduced {
-            // u = M⁻¹ E_Nᵀ w, then v = B_N u and b = w − C v.
-            for c in 0..nc {
-                for (j, &dir) in self.n_dirs.iter().enumerate() {
-                    self.reduced_rhs[(c * qn + j, 0)] = b[c * q + dir];
-                }
-            }
-            let u = reduced.solve(&self.reduced_rhs);
-            let mut v = vec![0.0; nc * qn];
-            for (&(_, first, _), je) in self.n_elements.iter().zip(&self.element_jacobians) {
-                let d = je.nrows() / nc;
-                for c1 in 0..nc {
-                    for a in 0..d {
-                        let mut s = 0.0;
-                        for c2 in 0..nc {
-                            for bb in 0..d {
-                                s += je[(c1 * d + a, c2 * d + bb)] * u[(c2 * qn + first + bb, 0)];
-                            }
+        let Some(reduced) = &self.reduced else { return b.iter().all(|v| v.is_finite()) };
+        // u = M⁻¹ E_Nᵀ w (real, coefficient-major on the N directions), v = B_N u.
+        let u = reduced.solve(Mat::from_fn(nc * qn, 1, |row, _| b[(row / qn) * q + self.n_dirs[row % qn]]));
+        let mut v = vec![0.0; nc * qn];
+        for (first, je) in &self.n_elements {
+            let d = je.nrows() / nc;
+            for c1 in 0..nc {
+                for a in 0..d {
+                    let mut sum = 0.0;
+                    for c2 in 0..nc {
+                        for bb in 0..d {
+                            sum += je[(c1 * d + a, c2 * d + bb)] * u[(c2 * qn + first + bb, 0)];
                         }
-                        v[c1 * qn + first + a] = s;
                     }
+                    v[c1 * qn + first + a] = sum;
                 }
             }
-            for (k, ck) in self.coupling.iter().enumerate() {
-                let coeffs: &[usize] = if k == 0 { &[0] } else { &[cos_index(k), sin_index(k)] };
-                let vk = Mat::from_fn(coeffs.len() * qn, 1, |j, _| v[coeffs[j / qn] * qn + j % qn]);
-                let cv = ck * &vk;
-                for i in 0..coeffs.len() * q {
-                    b[coeffs[i / q] * q + i % q] -= cv[(i, 0)];
-                }
+        }
+        // b = w − C v.
+        for (k, ck) in self.coupling.iter().enumerate() {
+            let cv = ck * Mat::from_fn(qn, 1, |j, _| complex_at(&v, qn, k, j));
+            for i in 0..q {
+                let w = complex_at(b, q, k, i);
+                set_complex(b, q, k, i, w - cv[(i, 0)]);
             }
         }
         b.iter().all(|v| v.is_finite())
     }
 }
 
-/// Does the block couple no two harmonics (entries between different harmonics negligible)?
-fn couples_no_harmonics(je: &Mat<f64>, d: usize) -> bool {
+/// `c − i s` of harmonic k, direction i, in a coefficient-major vector of width `width`.
+fn complex_at(x: &[f64], width: usize, k: usize, i: usize) -> c64 {
+    if k == 0 {
+        c64::new(x[i], 0.0)
+    } else {
+        c64::new(x[cos_index(k) * width + i], -x[sin_index(k) * width + i])
+    }
+}
+
+fn set_complex(x: &mut [f64], width: usize, k: usize, i: usize, v: c64) {
+    if k == 0 {
+        x[i] = v.re;
+    } else {
+        x[cos_index(k) * width + i] = v.re;
+        x[sin_index(k) * width + i] = -v.im;
+    }
+}
+
+/// `M = I + (E_Nᵀ C) B_N` on the real coefficient-major N unknowns `c·q_N + j`, with `E_Nᵀ C`
+/// in real form (`[[Re, Im], [−Im, Re]]` per harmonic).
+fn reduced_matrix(nc: usize, n_dirs: &[usize], n_elements: &[(usize, Mat<f64>)], coupling: &[Mat<c64>]) -> Mat<f64> {
+    let qn = n_dirs.len();
+    // G (real form) at (row coefficient c1, N-row i; column coefficient c2, N-column j).
+    let g = |c1: usize, i: usize, c2: usize, j: usize| -> f64 {
+        let k = harmonic_of(c1);
+        let v = coupling[k][(n_dirs[i], j)];
+        if k == 0 {
+            return v.re;
+        }
+        match (c1 % 2 == 1, c2 % 2 == 1) {
+            (true, true) | (false, false) => v.re,
+            (true, false) => v.im,
+            (false, true) => -v.im,
+        }
+    };
+    let mut m = Mat::<f64>::identity(nc * qn, nc * qn);
+    for (first, je) in n_elements {
+        let d = je.nrows() / nc;
+        for c_col in 0..nc {
+            for b in 0..d {
+                let col = c_col * qn + first + b;
+                for c2 in 0..nc {
+                    for a in 0..d {
+                        let v = je[(c2 * d + a, c_col * d + b)];
+                        if v == 0.0 {
+                            continue;
+                        }
+                        for c1 in coefficients(harmonic_of(c2)) {
+                            for i in 0..qn {
+                                m[(c1 * qn + i, col)] += g(c1, i, c2, first + a) * v;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    m
+}
+
+/// Is the block time-invariant over the period: no coupling between different harmonics, and
+/// within harmonic k the real form of a complex number (`K_ss = K_cc`, `K_sc = −K_cs`), all to
+/// [`INVARIANT`] of its largest entry?
+fn is_invariant(je: &Mat<f64>, d: usize) -> bool {
     let n = je.nrows();
     let mut largest = 0.0_f64;
     for j in 0..n {
@@ -260,5 +249,17 @@ fn couples_no_harmonics(je: &Mat<f64>, d: usize) -> bool {
             largest = largest.max(je[(i, j)].abs());
         }
     }
-    (0..n).all(|j| (0..n).all(|i| harmonic_of(i / d) == harmonic_of(j / d) || je[(i, j)].abs() <= INVARIANT * largest))
+    let tol = INVARIANT * largest;
+    let n_harmonics = (n / d - 1) / 2;
+    let coupled = (0..n).any(|j| (0..n).any(|i| harmonic_of(i / d) != harmonic_of(j / d) && je[(i, j)].abs() > tol));
+    let not_complex = (1..=n_harmonics).any(|k| {
+        let (c, s) = (cos_index(k) * d, sin_index(k) * d);
+        (0..d).any(|a| {
+            (0..d).any(|b| {
+                (je[(s + a, s + b)] - je[(c + a, c + b)]).abs() > tol
+                    || (je[(s + a, c + b)] + je[(c + a, s + b)]).abs() > tol
+            })
+        })
+    });
+    !(coupled || not_complex)
 }
