@@ -233,3 +233,32 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     assert_eq!(left, expected);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `params` lists its files per shard and `merge` its table, so that a smaller re-run into the
+/// same folder removes the curves of the samples it no longer has.
+#[test]
+fn a_parameter_study_rerun_removes_the_curves_of_samples_it_no_longer_has() {
+    let dir = scratch("params-files");
+    let study = repo().join("examples/jenkins-1dof/study.toml");
+    let run = |values: &str| {
+        let out = stickslip()
+            .args(["--threads", "1", "params", "--quiet", "--curves", "--vary"])
+            .arg(format!("excitation.levels[0]={values}"))
+            .arg(&study)
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    run("500,1000,1500");
+    assert!(dir.join("curves/sample-2.csv").exists());
+    let second = run("500,1000");
+    assert!(!dir.join("curves/sample-2.csv").exists(), "{second}");
+    assert!(dir.join("curves/sample-1.csv").exists());
+    let list = std::fs::read_to_string(dir.join("params-shard-1-of-1_files.txt")).unwrap();
+    assert_eq!(list.lines().count(), 3, "{list}");
+    assert!(std::fs::read_to_string(dir.join("merge_files.txt")).unwrap().contains("samples.csv"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -68,10 +68,17 @@ pub fn main(args: Args) -> anyhow::Result<()> {
             },
         )
         .collect();
+    let mut written = Vec::new();
     for o in &outcomes {
-        write_curves(&args.out, o)?;
+        written.extend(write_curves(&args.out, o)?);
     }
     let path = write_shard(&args.out, &study, shard, &outcomes)?;
+    written.push(path.clone());
+    // One file list per shard: the shards of an array job share the folder.
+    let list = format!("params-shard-{}-of-{}", shard.index, shard.count);
+    for old in stickslip_io::output::replace_previous_run(&args.out, &list, &written)? {
+        eprintln!("removed {} (written by the previous run)", old.display());
+    }
     let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
     eprintln!(
         "{total} sample(s) of {} ({}), {failed} failed, in {:.2} s: {}",
@@ -82,6 +89,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     );
     if shard.count == 1 {
         let (merged, _) = merge(&args.out)?;
+        stickslip_io::output::replace_previous_run(&args.out, "merge", std::slice::from_ref(&merged))?;
         eprintln!("table: {}", merged.display());
     }
     Ok(())
@@ -95,6 +103,7 @@ pub struct MergeArgs {
 
 pub fn merge_main(args: MergeArgs) -> anyhow::Result<()> {
     let (path, samples) = merge(&args.dir)?;
+    stickslip_io::output::replace_previous_run(&args.dir, "merge", std::slice::from_ref(&path))?;
     eprintln!("{samples} samples: {}", path.display());
     Ok(())
 }

@@ -247,7 +247,11 @@ impl ElementAft {
                 self.slipping[j0] = law.is_slipping(&self.state, &self.state_after_start);
                 break;
             }
-            let scale = self.state_period_start.iter().chain(&self.state).fold(0.0f64, |m, x| m.max(x.abs()));
+            // Relative to the motion as well as to the state: a slider that barely moves (a state
+            // of 1e-14 m under a motion of 1e-5 m) repeats to round-off of the motion, not of
+            // its own size.
+            let scale =
+                self.state_period_start.iter().chain(&self.state).chain(&self.u).fold(0.0f64, |m, x| m.max(x.abs()));
             let change = self.state_period_start.iter().zip(&self.state).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
             if change <= PERIODICITY_TOLERANCE * scale.max(f64::MIN_POSITIVE) {
                 break;
