@@ -114,7 +114,7 @@ fn sets_that_do_not_pair_up_are_refused_naming_the_nodes() {
     extra.sort_unstable();
     mesh.node_sets.insert("B_LONG".into(), extra);
     let message = error(&mesh, "A_CONTACT", "B_LONG", None);
-    assert!(message.contains(&format!("1 node(s) of \"B_LONG\"")) && message.contains(&mesh.nodes[top].id.to_string()));
+    assert!(message.contains("1 node(s) of \"B_LONG\"") && message.contains(&mesh.nodes[top].id.to_string()));
 
     // A whole set elsewhere: at most ten ids, and the count.
     let message = error(&mesh, "A_CONTACT", "BOLT_TOP", None);
