@@ -387,16 +387,13 @@ pub struct Spring<'v> {
     pub vector: &'v [(usize, f64)],
 }
 
-/// Static displacement of `(K + Σ k v vᵀ) u = F`: the structure with its contacts closed and
-/// stuck (each contact's stiffnesses as springs), under the preload `F` (N).
-pub fn static_displacement(stiffness: &Matrix, springs: &[Spring], force: &[f64]) -> Result<Vec<f64>, PatchError> {
+/// `K + Σ k v vᵀ`: the stiffness with the springs added (the structure with its contacts
+/// closed and stuck, each contact's stiffnesses as springs), sparse.
+pub fn with_springs(stiffness: &Matrix, springs: &[Spring]) -> SparseColMat<usize, f64> {
     let n = stiffness.nrows();
-    if force.len() != n {
-        return Err(PatchError::LoadSize { got: force.len(), expected: n });
-    }
     let k = to_sparse(stiffness);
-    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(k.compute_nnz());
     let k = k.as_ref().as_ref();
+    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(k.compute_nnz());
     for j in 0..n {
         for (&i, &v) in k.symbolic().row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
             triplets.push(Triplet::new(i, j, v));
@@ -410,9 +407,18 @@ pub fn static_displacement(stiffness: &Matrix, springs: &[Spring], force: &[f64]
         }
     }
     // Duplicates (K's entry and the springs' at one position) are summed.
-    let closed = SparseColMat::try_new_from_triplets(n, n, &triplets)
-        .map_err(|e| PatchError::Static(EigenError::Factorisation(format!("{e:?}"))))?;
-    let factor = ShiftedFactor::new(closed.as_ref(), None, 0.0)?;
+    SparseColMat::try_new_from_triplets(n, n, &triplets).expect("indices of the model's DOFs are in range")
+}
+
+/// Static displacement `u` of `K u = F` under the preload `F` (N), `K` the stiffness of the
+/// structure with its contacts closed ([`with_springs`]).
+pub fn static_displacement(stiffness: &Matrix, force: &[f64]) -> Result<Vec<f64>, PatchError> {
+    let n = stiffness.nrows();
+    if force.len() != n {
+        return Err(PatchError::LoadSize { got: force.len(), expected: n });
+    }
+    let k = to_sparse(stiffness);
+    let factor = ShiftedFactor::new(k.as_ref().as_ref(), None, 0.0)?;
     if factor.eigenvalues_below_shift() > 0 {
         return Err(PatchError::Static(EigenError::Singular { shift: 0.0, dof: None }));
     }

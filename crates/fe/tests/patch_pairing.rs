@@ -8,7 +8,7 @@ use stickslip_fe::mesh::generate::box_mesh;
 use stickslip_fe::mesh::lap_joint::LapJoint;
 use stickslip_fe::mesh::{Material, Mesh};
 use stickslip_fe::patch::{
-    normal_forces, pair_sets, pair_vectors, spread_force, static_displacement, PatchError, Spring,
+    normal_forces, pair_sets, pair_vectors, spread_force, static_displacement, with_springs, PatchError, Spring,
 };
 
 const STEEL: Material = Material { young: 2.1e11, poisson: 0.3, density: 7800.0 };
@@ -149,7 +149,8 @@ fn preload(fe: &FeModel, force_top: f64, force_bottom: f64) -> Result<(Vec<f64>,
     let mut f = spread_force(fe, fe.mesh.node_set("BOLT_TOP").unwrap(), [0.0, 0.0, -force_top]);
     let bottom = spread_force(fe, fe.mesh.node_set("BOLT_BOTTOM").unwrap(), [0.0, 0.0, force_bottom]);
     f.iter_mut().zip(bottom).for_each(|(x, y)| *x += y);
-    let u = static_displacement(&fe.model.stiffness, &springs, &f)?;
+    let closed = stickslip_core::model::Matrix::Sparse(with_springs(&fe.model.stiffness, &springs));
+    let u = static_displacement(&closed, &f)?;
     let normals: Vec<&[(usize, f64)]> = vectors.iter().map(|v| v[2].as_slice()).collect();
     let kn_pairs: Vec<f64> = areas.iter().map(|a| kn * a).collect();
     let forces = normal_forces(fe, &patch.pairs, &normals, &kn_pairs, &u)?;
