@@ -136,14 +136,16 @@ fn a_pressure_patch_gives_one_contact_per_pair_scaled_by_its_area() {
     assert!((preload - exact).abs() < 1e-9 * exact, "total preload {preload} N vs {exact} N");
 }
 
-/// The preload N0 of a contact law that replaces its stiffnesses: wide open (u_n = −h, −2h),
-/// its restoring normal force is g_n = −N0 + k_n u_n... with the replaced k_n u_n added back:
-/// g_n(−h) = −N0 + k_n h, so N0 = g_n(−2h) − 2 g_n(−h). Round-off: k_n h (≤ 1e7 N) × 1e-16.
+/// The preload N0 of a contact law (2-D or 3-D) that replaces its stiffnesses: wide open
+/// (u_n = −h), its restoring normal force is g_n = 0 − N0 − k_n u_n = −N0 + k_n h, so
+/// N0 = g_n(−2h) − 2 g_n(−h). Round-off: k_n h (≤ 2e5 N) × 1e-16.
 fn contact_preload(law: &dyn stickslip_core::elements::Element) -> f64 {
+    let d = law.n_dirs();
     let g_open = |h: f64| {
-        let (mut g, mut w) = ([0.0; 3], [0.0; 2]);
-        law.update(&[0.0, 0.0, -h], &[0.0; 3], &mut w, &mut g, None);
-        g[2]
+        let (mut u, mut g, mut w) = ([0.0; 3], [0.0; 3], [0.0; 2]);
+        u[d - 1] = -h;
+        law.update(&u[..d], &[0.0; 3][..d], &mut w[..d - 1], &mut g[..d], None);
+        g[d - 1]
     };
     g_open(2e-3) - 2.0 * g_open(1e-3)
 }
@@ -203,7 +205,7 @@ fn condensed_balance_equals_the_full_balance_with_a_20_node_patch() {
     let nc = 2 * settings.harmonics + 1;
     let recovered: Vec<f64> = (0..nc * n).map(|idx| p.outputs[idx % n].coeffs[idx / n]).collect();
     // Both solve the same equations. The stiff contacts (k_n A up to 2e8 N/m against the
-    // plates' bending) condition the full balance: measured 1.0e-9 to 1.4e-9 from run to run
+    // plates' bending) condition the full balance: measured 1.0e-9 to 2.2e-9 from run to run
     // (the reduction's modes differ in the last bits); bound 1e-8.
     let err = hbm_support::full_balance_distance(&model, &excitation.pattern, settings, omega, level, &recovered, 40);
     println!("condensed vs full, 20-node patch: {err:.2e}");
@@ -290,4 +292,21 @@ fn bad_patches_are_refused_naming_the_key_the_sets_and_the_nodes() {
     let matrices = "[model]\ndofs = [\"a\"]\nmass = [1.0]\nstiffness = [1.0]\n\n[[load]]\nname = \"f\"\ndof = \"a\"\n\n[[patch]]\nname = \"p\"\nbetween = [\"A\", \"B\"]\nlaw = \"contact3d\"\nfriction = 0.3\nnormal_stiffness_per_area = 1.0\ntangential_stiffness_per_area = 1.0\npressure = 1.0\n\n[excitation]\nlevels = [1.0]\n\n[sweep]\nstart_hz = 1.0\nend_hz = 2.0\n";
     let message = load(&dir, matrices).unwrap_err();
     assert!(message.contains("the [model] must be a `mesh` or `harmony`"), "{message}");
+}
+
+#[test]
+fn the_lap_joint_example_builds_its_patch_and_its_jenkins_simplification() {
+    let examples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/lap-joint");
+    let (model, _, _) = Study::load(examples.join("study.toml")).unwrap().build_model().unwrap();
+    assert_eq!(model.elements.len(), 29);
+    assert!(model.elements.iter().all(|e| e.law.kind() == "contact2d"));
+    // The bolt's 2 kN is carried by the pairs at rest.
+    let preloads: Vec<f64> = model.elements.iter().map(|e| contact_preload(e.law.as_ref())).collect();
+    let total: f64 = preloads.iter().sum();
+    let (least, most) = preloads.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+    println!("lap joint example: preloads from {least:.1} to {most:.1} N, {total:.6} N in all");
+    assert!((total - 2000.0).abs() < 1e-8 * 2000.0, "sum of preloads {total} N");
+    let (jenkins, _, _) = Study::load(examples.join("study-jenkins.toml")).unwrap().build_model().unwrap();
+    assert_eq!(jenkins.elements.len(), 1);
+    assert_eq!(jenkins.elements[0].law.kind(), "jenkins");
 }
