@@ -270,27 +270,23 @@ pub fn pair_sets(
             }
         }
     }
+    // Nodes of `set` without a partner in `other`.
+    let unpaired_error = |set: &str, other: &str, nodes: &[usize]| PatchError::Unpaired {
+        set: set.into(),
+        other: other.into(),
+        count: nodes.len(),
+        tolerance,
+        nodes: listed(mesh, nodes),
+    };
     if !unpaired.is_empty() {
-        return Err(PatchError::Unpaired {
-            set: a.into(),
-            other: b.into(),
-            count: unpaired.len(),
-            tolerance,
-            nodes: listed(mesh, &unpaired),
-        });
+        return Err(unpaired_error(a, b, &unpaired));
     }
     if !twice.is_empty() {
         return Err(PatchError::Ambiguous { a: a.into(), b: b.into(), nodes: listed(mesh, &twice) });
     }
     let alone: Vec<usize> = set_b.iter().copied().filter(|&n| partner_of_b[n].is_none()).collect();
     if !alone.is_empty() {
-        return Err(PatchError::Unpaired {
-            set: b.into(),
-            other: a.into(),
-            count: alone.len(),
-            tolerance,
-            nodes: listed(mesh, &alone),
-        });
+        return Err(unpaired_error(b, a, &alone));
     }
 
     let direction_error = |message: String| PatchError::Direction { a: a.into(), b: b.into(), message };

@@ -76,7 +76,11 @@ fn check(name: &str, mesh: &Mesh) {
         std::fs::write(&path, &text).unwrap();
     }
     let shipped = std::fs::read_to_string(&path).unwrap_or_default();
-    assert!(shipped == text, "{} differs from the generator; rewrite it with STICKSLIP_WRITE_EXAMPLES=1", path.display());
+    assert!(
+        shipped == text,
+        "{} differs from the generator; rewrite it with STICKSLIP_WRITE_EXAMPLES=1",
+        path.display()
+    );
 }
 
 #[test]
