@@ -6,11 +6,16 @@ use common::{columns, repo, run_table6, scratch, stickslip};
 
 /// Run a shipped example into a scratch folder; its FRF table as (header, rows), and the folder.
 fn run_example(name: &str) -> (Vec<String>, Vec<Vec<f64>>, PathBuf) {
-    let out = scratch(name);
+    run_example_file(name, "study.toml")
+}
+
+/// As [`run_example`], for the study file `file` of example `name`.
+fn run_example_file(name: &str, file: &str) -> (Vec<String>, Vec<Vec<f64>>, PathBuf) {
+    let out = scratch(&format!("{name}-{}", file.trim_end_matches(".toml")));
     let status = stickslip()
         .args(["run", "--quiet", "--out"])
         .arg(&out)
-        .arg(repo().join(format!("examples/{name}/study.toml")))
+        .arg(repo().join(format!("examples/{name}/{file}")))
         .status()
         .unwrap();
     assert!(status.success(), "{name}");
@@ -352,14 +357,7 @@ fn the_lap_joint_patch_softens_where_its_jenkins_simplification_stays_stuck() {
     assert!(patch[1].1 < patch[0].1 && patch[2].1 < patch[1].1, "the peak does not soften");
     assert!(patch[1].2 < 0.97 * patch[0].2 && patch[2].2 < patch[1].2, "the peak does not flatten");
 
-    let jenkins_out = scratch("lap-joint-jenkins");
-    let status = stickslip()
-        .args(["run", "--quiet", "--out"])
-        .arg(&jenkins_out)
-        .arg(repo().join("examples/lap-joint/study-jenkins.toml"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (_, _, jenkins_out) = run_example_file("lap-joint", "study-jenkins.toml");
     let jenkins = peaks(&jenkins_out);
     println!("Jenkins peaks: {jenkins:?}");
     assert!((jenkins[0].1 - 32.594).abs() < 0.01 && (jenkins[0].2 - 8.489e-3).abs() < 1e-5, "{:?}", jenkins[0]);
