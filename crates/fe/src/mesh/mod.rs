@@ -12,6 +12,7 @@ pub mod gmsh;
 pub mod gmsh_writer;
 pub mod inp;
 pub mod inp_writer;
+pub mod lap_joint;
 pub mod structured;
 pub mod vtk;
 

@@ -12,6 +12,9 @@ use stickslip_core::model::{
 use stickslip_fe::assembly::FeModel;
 use stickslip_fe::eigen::EigenOptions;
 use stickslip_fe::mesh::Material;
+use stickslip_fe::patch::{
+    normal_forces, pair_sets, pair_vectors, spread_force, static_displacement, with_springs, ContactPair, Spring,
+};
 use stickslip_fe::reduction::{self, Reduction, ReductionOptions, Release};
 
 use super::*;
@@ -48,6 +51,8 @@ pub struct LinearPart {
     reduction: Option<ReductionSpec>,
     damping_matrix: Option<DampingSpec>,
     releases: Vec<(String, Placement, JointStiffness)>,
+    /// Patches are paired, preloaded and retained by the reduction on the full mesh.
+    patches: Vec<PatchSpec>,
 }
 
 /// The linear model the nonlinear analysis runs on (the model as given, or its reduction),
@@ -60,7 +65,50 @@ pub struct LinearBase {
     reduction: Option<Reduction>,
     model_at: ModelLocations,
     part: LinearPart,
+    patches: Vec<BuiltPatch>,
 }
+
+/// A `[[patch]]` paired on the mesh: its contacts' parameters and directions.
+#[derive(Clone, Debug)]
+struct BuiltPatch {
+    name: String,
+    tangential_directions: usize,
+    friction: f64,
+    pairs: Vec<BuiltPair>,
+    at: Location,
+}
+
+/// One contact of a patch.
+#[derive(Clone, Debug)]
+struct BuiltPair {
+    /// Id of the pair's node in the first set (names the element).
+    node: u64,
+    normal_stiffness: f64,
+    tangential_stiffness: f64,
+    /// Normal load at rest (N).
+    preload: f64,
+    /// Tangential directions then the normal: `(U_a − U_b)·d` as sparse vectors over the full
+    /// model's DOFs.
+    directions: Vec<Vec<(usize, f64)>>,
+    /// `contact2d`: the second tangential direction, held by a linear spring of the tangential
+    /// stiffness (the contact slides along its one tangential direction only).
+    held: Option<Vec<(usize, f64)>>,
+}
+
+impl BuiltPair {
+    /// Stiffness of the contact along its direction `i` (tangential ones first, then normal).
+    fn stiffness(&self, i: usize) -> f64 {
+        if i + 1 < self.directions.len() {
+            self.tangential_stiffness
+        } else {
+            self.normal_stiffness
+        }
+    }
+}
+
+/// Most contact pairs of all patches together: each is a 3-direction element of the condensed
+/// balance, whose dense Jacobian grows with the square of their number.
+const MAX_PATCH_PAIRS: usize = 5000;
 
 impl LinearBase {
     /// The study inputs the base was built from.
@@ -136,6 +184,7 @@ impl Study {
                 _ => None,
             },
             releases,
+            patches: self.patches.clone(),
         }
     }
 
@@ -144,23 +193,28 @@ impl Study {
     /// `timings`).
     pub fn build_linear_base(&self, timings: &mut Vec<(String, f64)>) -> Result<LinearBase, StudyError> {
         let err = |at: Location, kind: StudyErrorKind| self.error(Some(at), kind);
-        let (full, model_at) = self.full_model(timings)?;
+        let (mut full, model_at) = self.full_model(timings)?;
         // Reduction (Section 3.3): the nonlinear analysis runs on the reduced model; loads,
         // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
         // u = Vᵀ U = (Tᵀ V)ᵀ q).
         let full_dofs = full.linear().dofs.clone();
+        let started = std::time::Instant::now();
+        let (patches, patch_dofs) = self.contact_patches(full.fe_mut())?;
+        if !patches.is_empty() {
+            timings.push(("contact patches".into(), started.elapsed().as_secs_f64()));
+        }
         let (linear, reduction) = match &self.reduction {
             None => (full.into_linear(), None),
             Some(r) => {
                 let releases = self.releases(full.linear())?;
                 let started = std::time::Instant::now();
-                let red = reduce(&full, r, &releases).map_err(|k| err(r.at, k))?;
+                let red = reduce(&full, r, &releases, &patch_dofs).map_err(|k| err(r.at, k))?;
                 timings.push(("modes and reduction".into(), started.elapsed().as_secs_f64()));
                 timings.extend(red.stages.iter().map(|(stage, secs)| (format!("  {stage}"), *secs)));
                 (red.model.clone(), Some(red))
             }
         };
-        Ok(LinearBase { full_dofs, linear, reduction, model_at, part: self.linear_part() })
+        Ok(LinearBase { full_dofs, linear, reduction, model_at, part: self.linear_part(), patches })
     }
 
     /// The nonlinear model, excitation and outputs of this study on a linear base built by a
@@ -207,6 +261,9 @@ impl Study {
             sites.push(site);
         }
         check_slipped_stiffness(&linear, &replaced).map_err(|(at, m)| err(at, StudyErrorKind::Invalid(m)))?;
+        for p in &base.patches {
+            patch_sites(p, &space, &mut sites).map_err(|k| err(p.at, k))?;
+        }
 
         let load_name = match &self.excitation.load {
             Some(name) => name.clone(),
@@ -330,6 +387,153 @@ impl Study {
         Ok((FullModel::Matrices(linear), at))
     }
 
+    /// The `[[patch]]`es paired on the mesh, with their contacts' stiffnesses, preloads and
+    /// directions, and the DOFs of their node sets (which a reduction keeps). The contacts'
+    /// stiffnesses, closed and stuck, are added to the model's K (the paper form, Eq. 11: each
+    /// contact element replaces its own), so that the linear model holds the assembled structure
+    /// (a part held by the contacts alone is not free in it) and a reduction's modes are those
+    /// of the joint stuck.
+    fn contact_patches(&self, fe: Option<&mut FeModel>) -> Result<(Vec<BuiltPatch>, Vec<usize>), StudyError> {
+        let Some(first) = self.patches.first() else { return Ok((Vec::new(), Vec::new())) };
+        let Some(fe) = fe else {
+            return Err(self.error(
+                Some(first.at),
+                StudyErrorKind::Invalid(format!("[[patch]] {:?}: a patch pairs node sets of a mesh model", first.name)),
+            ));
+        };
+        let patch_error = |spec: &PatchSpec, source| {
+            self.error(Some(spec.at), StudyErrorKind::Patch { context: format!("[[patch]] {:?}", spec.name), source })
+        };
+        let (mut built, mut retained, mut n_pairs) = (Vec::new(), Vec::new(), 0);
+        for spec in &self.patches {
+            let patch = pair_sets(&fe.mesh, &spec.sets[0], &spec.sets[1], spec.normal, spec.tangential)
+                .map_err(|e| patch_error(spec, e))?;
+            n_pairs += patch.pairs.len();
+            if n_pairs > MAX_PATCH_PAIRS {
+                return Err(self.error(
+                    Some(spec.at),
+                    StudyErrorKind::Invalid(format!(
+                        "[[patch]] {:?}: the patches have {n_pairs} contact pairs or more; at most {MAX_PATCH_PAIRS} are accepted (each is a contact element of the harmonic balance): mesh the interface coarser",
+                        spec.name
+                    )),
+                ));
+            }
+            let names = ["t1", "t2"];
+            let directions: Vec<([f64; 3], &str)> = (0..spec.tangential_directions)
+                .map(|i| (patch.tangents[i], names[i]))
+                .chain([(patch.normal, "normal")])
+                .collect();
+            let mut pairs = Vec::with_capacity(patch.pairs.len());
+            for p in &patch.pairs {
+                let held = if spec.tangential_directions == 1 {
+                    let mut v = pair_vectors(fe, p, &[(patch.tangents[1], "t2")]).map_err(|e| patch_error(spec, e))?;
+                    v.pop()
+                } else {
+                    None
+                };
+                pairs.push(BuiltPair {
+                    held,
+                    node: fe.mesh.nodes[p.a].id,
+                    normal_stiffness: spec.normal_stiffness_per_area * p.area,
+                    tangential_stiffness: spec.tangential_stiffness_per_area * p.area,
+                    preload: match spec.preload {
+                        PatchPreload::Pressure(pressure) => pressure * p.area,
+                        // From the static pre-step below.
+                        PatchPreload::Forces(_) => 0.0,
+                    },
+                    directions: pair_vectors(fe, p, &directions).map_err(|e| patch_error(spec, e))?,
+                });
+            }
+            for set in &spec.sets {
+                for d in fe.set_dofs(set).map_err(|source| {
+                    self.error(
+                        Some(spec.at),
+                        StudyErrorKind::Assembly { context: format!("[[patch]] {:?}", spec.name), source },
+                    )
+                })? {
+                    if !retained.contains(&d) {
+                        retained.push(d);
+                    }
+                }
+            }
+            built.push((
+                BuiltPatch {
+                    name: spec.name.clone(),
+                    tangential_directions: spec.tangential_directions,
+                    friction: spec.friction,
+                    pairs,
+                    at: spec.at,
+                },
+                patch.pairs,
+            ));
+        }
+        let closed = {
+            let mut springs = Vec::new();
+            for (patch, _) in &built {
+                for pair in &patch.pairs {
+                    for (i, v) in pair.directions.iter().enumerate() {
+                        springs.push(Spring { stiffness: pair.stiffness(i), vector: v });
+                    }
+                    if let Some(v) = &pair.held {
+                        springs.push(Spring { stiffness: pair.tangential_stiffness, vector: v });
+                    }
+                }
+            }
+            with_springs(&fe.model.stiffness, &springs)
+        };
+        fe.model.stiffness = Matrix::Sparse(closed);
+        if self.patches.iter().any(|p| matches!(p.preload, PatchPreload::Forces(_))) {
+            self.static_pre_step(fe, &mut built)?;
+        }
+        Ok((built.into_iter().map(|(b, _)| b).collect(), retained))
+    }
+
+    /// The static pre-step on the model with every patch closed and stuck: the `preload_forces`
+    /// of every patch applied together; each pair of a patch preloaded by forces takes its
+    /// normal force there, and a pair not pressed is an error naming it.
+    fn static_pre_step(&self, fe: &FeModel, built: &mut [(BuiltPatch, Vec<ContactPair>)]) -> Result<(), StudyError> {
+        let mut force = vec![0.0; fe.model.n_dofs()];
+        for spec in &self.patches {
+            let PatchPreload::Forces(forces) = &spec.preload else { continue };
+            for (set, total) in forces {
+                let Some(nodes) = fe.mesh.node_set(set) else {
+                    let known: Vec<&String> = fe.mesh.node_sets.keys().collect();
+                    return Err(self.error(
+                        Some(spec.at),
+                        StudyErrorKind::Invalid(format!(
+                            "[[patch]] {:?}: preload_forces: no node set {set:?} in the mesh; its sets are {known:?}",
+                            spec.name
+                        )),
+                    ));
+                };
+                let f = spread_force(fe, nodes, *total);
+                force.iter_mut().zip(f).for_each(|(x, y)| *x += y);
+            }
+        }
+        // `built` follows `self.patches`.
+        let by_forces = |i: usize| matches!(self.patches[i].preload, PatchPreload::Forces(_));
+        let at = (0..built.len()).find(|&i| by_forces(i)).map(|i| built[i].0.at);
+        let u = static_displacement(&fe.model.stiffness, &force).map_err(|source| {
+            self.error(at, StudyErrorKind::Patch { context: "[[patch]] preload_forces".into(), source })
+        })?;
+        for (i, (patch, pairs)) in built.iter_mut().enumerate() {
+            if !by_forces(i) {
+                continue;
+            }
+            let normals: Vec<&[(usize, f64)]> =
+                patch.pairs.iter().map(|p| p.directions.last().expect("a normal direction").as_slice()).collect();
+            let kn: Vec<f64> = patch.pairs.iter().map(|p| p.normal_stiffness).collect();
+            let n0 = normal_forces(fe, pairs, &normals, &kn, &u).map_err(|source| {
+                self.error(
+                    Some(patch.at),
+                    StudyErrorKind::Patch { context: format!("[[patch]] {:?}", patch.name), source },
+                )
+            })?;
+            patch.pairs.iter_mut().zip(n0).for_each(|(p, n)| p.preload = n);
+        }
+        Ok(())
+    }
+
     /// The joints that replace stiffness of the full model, as releases for the enriched
     /// reduction (their connector `k d dᵀ` removed from K).
     fn releases(&self, full: &LinearModel) -> Result<Vec<Release>, StudyError> {
@@ -428,6 +632,48 @@ impl Study {
     }
 }
 
+/// The contact elements of a patch, one per pair, named `patch-node` (the id of the pair's
+/// node in the first set), on their directions projected onto the analysed model.
+fn patch_sites(patch: &BuiltPatch, space: &DofSpace, sites: &mut Vec<ElementSite>) -> Result<(), StudyErrorKind> {
+    let ctx = format!("[[patch]] {:?}", patch.name);
+    let n = space.dofs.len();
+    for pair in &patch.pairs {
+        let name = format!("{}-{}", patch.name, pair.node);
+        if sites.iter().any(|s| s.name == name) {
+            return Err(StudyErrorKind::Invalid(format!(
+                "{ctx}: its contact {name:?} has the name of another joint or contact; rename the patch or the joint"
+            )));
+        }
+        let directions = pair
+            .directions
+            .iter()
+            .map(|sparse| {
+                let mut v = vec![0.0; n];
+                sparse.iter().for_each(|&(i, c)| v[i] = c);
+                match space.reduction {
+                    Some(r) => r.project(&v),
+                    None => v,
+                }
+            })
+            .collect();
+        let (kt, kn) = (pair.tangential_stiffness, pair.normal_stiffness);
+        let element_error = |source| StudyErrorKind::Element { context: format!("{ctx} contact {name:?}"), source };
+        let law = if patch.tangential_directions == 1 {
+            Contact::new_2d(kt, kn, patch.friction, pair.preload)
+        } else {
+            Contact::new_3d(kt, kn, patch.friction, pair.preload)
+        }
+        .map_err(element_error)?;
+        // K holds the contact's stiffnesses along its own directions (see `contact_patches`).
+        let d = pair.directions.len();
+        let replaced: Vec<f64> =
+            (0..d * d).map(|e| if e % (d + 1) == 0 { pair.stiffness(e / d) } else { 0.0 }).collect();
+        let law = law.replacing_stiffness(&replaced).map_err(element_error)?;
+        sites.push(ElementSite { name, law: Box::new(law), directions });
+    }
+    Ok(())
+}
+
 /// Largest model on which the slipped stiffness is checked (a dense symmetric eigensolution).
 const MAX_SLIPPED_CHECK_DOFS: usize = 3000;
 
@@ -486,6 +732,13 @@ impl FullModel {
     }
 
     fn fe(&self) -> Option<&FeModel> {
+        match self {
+            FullModel::Matrices(_) => None,
+            FullModel::Mesh(fe) => Some(fe),
+        }
+    }
+
+    fn fe_mut(&mut self) -> Option<&mut FeModel> {
         match self {
             FullModel::Matrices(_) => None,
             FullModel::Mesh(fe) => Some(fe),
@@ -603,11 +856,17 @@ fn read_mesh(path: &Path, material: Option<&MaterialSpec>, fixed: &[FixedSet]) -
 }
 
 /// The reduction of `[reduction]`: retained DOFs from node sets (mesh) or DOF names.
-fn reduce(full: &FullModel, spec: &ReductionSpec, releases: &[Release]) -> Result<Reduction, StudyErrorKind> {
+/// `patch_dofs`, the DOFs of the contact patches' node sets, are retained besides `retain`.
+fn reduce(
+    full: &FullModel,
+    spec: &ReductionSpec,
+    releases: &[Release],
+    patch_dofs: &[usize],
+) -> Result<Reduction, StudyErrorKind> {
     let (fe, full) = (full.fe(), full.linear());
     const CTX: &str = "[reduction] retain";
     let space = DofSpace { dofs: &full.dofs, reduction: None };
-    let mut retained: Vec<usize> = Vec::new();
+    let mut retained: Vec<usize> = patch_dofs.to_vec();
     for name in &spec.retain {
         let set = fe.and_then(|fe| fe.mesh.node_set(name).map(|_| fe.set_dofs(name)));
         let dofs = match set {

@@ -32,6 +32,8 @@ pub struct Study {
     pub damping: DampingSpec,
     pub loads: Vec<LoadSpec>,
     pub joints: Vec<JointSpec>,
+    /// `[[patch]]`: contact patches between node sets of a mesh model.
+    pub patches: Vec<PatchSpec>,
     pub excitation: ExcitationSpec,
     pub sweep: SweepSettings,
     pub hbm: HbmSettings,
@@ -234,6 +236,38 @@ pub struct JointSpec {
     pub at: Location,
 }
 
+/// How a patch's contacts are loaded at rest.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PatchPreload {
+    /// A uniform contact pressure (Pa): each pair carries it over its tributary area.
+    Pressure(f64),
+    /// Static forces (N, x y z), each spread equally over the nodes of a node set, applied in
+    /// one static pre-step with every patch closed; each pair carries its normal force there.
+    Forces(Vec<(String, [f64; 3])>),
+}
+
+/// `[[patch]]`: a node-to-node contact patch between two node sets of a mesh (conforming
+/// surfaces): each pair of coincident nodes is a contact element (`contact2d` or `contact3d`)
+/// on the relative displacement of its two nodes, stiffnesses scaled by its tributary area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchSpec {
+    pub name: String,
+    /// The node sets: the first's faces give the areas, the normal points from it into the second.
+    pub sets: [String; 2],
+    /// 1 (`contact2d`) or 2 (`contact3d`) tangential directions.
+    pub tangential_directions: usize,
+    pub friction: f64,
+    /// N/m³: the stiffness of a pair is this times its area.
+    pub normal_stiffness_per_area: f64,
+    pub tangential_stiffness_per_area: f64,
+    pub preload: PatchPreload,
+    /// Normal from the first set's body into the second's; `None`: the faces' average.
+    pub normal: Option<[f64; 3]>,
+    /// First tangential direction (projected on the interface); required for `contact2d`.
+    pub tangential: Option<[f64; 3]>,
+    pub at: Location,
+}
+
 /// Which load excites the structure and at which levels.
 #[derive(Clone, Debug)]
 pub struct ExcitationSpec {
@@ -423,6 +457,12 @@ pub enum StudyErrorKind {
         context: String,
         #[source]
         source: stickslip_fe::reduction::ReductionError,
+    },
+    #[error("{context}: {source}")]
+    Patch {
+        context: String,
+        #[source]
+        source: stickslip_fe::patch::PatchError,
     },
     #[error("{context}: {source}")]
     Element {

@@ -18,6 +18,8 @@ pub(crate) struct RawStudy {
     pub load: Vec<S<RawLoad>>,
     #[serde(default)]
     pub joint: Vec<S<RawJoint>>,
+    #[serde(default)]
+    pub patch: Vec<S<RawPatch>>,
     pub excitation: S<RawExcitation>,
     pub sweep: S<RawSweep>,
     pub harmonic_balance: Option<S<RawHarmonicBalance>>,
@@ -134,6 +136,30 @@ pub(crate) struct RawJoint {
     pub normal_stiffness: Option<S<f64>>,
     pub tangential_stiffness: Option<S<f64>>,
     pub friction: Option<S<f64>>,
+}
+
+/// `[[patch]]`: node-to-node contacts between two node sets of a mesh.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawPatch {
+    pub name: S<String>,
+    pub between: S<Vec<String>>,
+    pub law: S<String>,
+    pub friction: Option<S<f64>>,
+    pub normal_stiffness_per_area: Option<S<f64>>,
+    pub tangential_stiffness_per_area: Option<S<f64>>,
+    pub pressure: Option<S<f64>>,
+    pub preload_forces: Option<S<Vec<S<RawPreloadForce>>>>,
+    pub normal: Option<S<Vec<f64>>>,
+    pub tangential: Option<S<Vec<f64>>>,
+}
+
+/// `{ set = "BOLT", force = [fx, fy, fz] }`: a static force (N) spread over a node set.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawPreloadForce {
+    pub set: S<String>,
+    pub force: S<Vec<f64>>,
 }
 
 #[derive(Deserialize)]

@@ -111,6 +111,12 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         joints.push(joint(&src, j)?);
     }
     unique_names(&src, raw.joint.iter().map(|j| &j.get_ref().name), "[[joint]]")?;
+    let mesh_model = matches!(model, ModelSpec::Mesh { .. } | ModelSpec::Harmony { .. });
+    let mut patches = Vec::with_capacity(raw.patch.len());
+    for p in &raw.patch {
+        patches.push(patch(&src, p, mesh_model)?);
+    }
+    unique_names(&src, raw.patch.iter().map(|p| &p.get_ref().name), "[[patch]]")?;
 
     let excitation = excitation(&src, &raw.excitation, &loads)?;
     let sweep = sweep(&src, &raw.sweep)?;
@@ -179,6 +185,7 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         damping,
         loads,
         joints,
+        patches,
         excitation,
         sweep,
         hbm,
@@ -816,17 +823,7 @@ fn contact_law(
         None => {
             return Err(src.invalid(whole, format!("{ctx}: law {law:?} needs `friction`, the friction coefficient μ")))
         }
-        Some(f) => {
-            let mu = *f.get_ref();
-            let max = stickslip_core::elements::MAX_FRICTION_COEFFICIENT;
-            if !(mu.is_finite() && (0.0..=max).contains(&mu)) {
-                return Err(src.invalid(
-                    &f.span(),
-                    format!("{ctx}: friction must lie in [0, {max}] (a coefficient, not a force), got {mu}"),
-                ));
-            }
-            mu
-        }
+        Some(f) => friction_coefficient(src, f, ctx)?,
     };
     let preload = match &r.preload {
         None => {
@@ -944,6 +941,131 @@ fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
         },
     };
     Ok(JointSpec { name: r.name.get_ref().clone(), law, placement, at: src.location(&pspan) })
+}
+
+/// A friction coefficient in [0, MAX_FRICTION_COEFFICIENT].
+fn friction_coefficient(src: &Source, f: &S<f64>, ctx: &str) -> Result<f64, StudyError> {
+    let mu = *f.get_ref();
+    let max = stickslip_core::elements::MAX_FRICTION_COEFFICIENT;
+    if !(mu.is_finite() && (0.0..=max).contains(&mu)) {
+        return Err(src.invalid(
+            &f.span(),
+            format!("{ctx}: friction must lie in [0, {max}] (a coefficient, not a force), got {mu}"),
+        ));
+    }
+    Ok(mu)
+}
+
+/// A direction `[x, y, z]`: three finite values, not all zero.
+fn direction(src: &Source, v: &S<Vec<f64>>, ctx: &str, key: &str) -> Result<[f64; 3], StudyError> {
+    let x = finite_list(src, v, ctx, key)?;
+    match x[..] {
+        [a, b, c] if a != 0.0 || b != 0.0 || c != 0.0 => Ok([a, b, c]),
+        _ => Err(src.invalid(&v.span(), format!("{ctx}: {key} must be a direction [x, y, z], not zero, got {x:?}"))),
+    }
+}
+
+/// Most static forces of one patch's pre-step.
+const MAX_PRELOAD_FORCES: usize = 1000;
+
+fn patch(src: &Source, p: &S<raw::RawPatch>, mesh_model: bool) -> Result<PatchSpec, StudyError> {
+    let r = p.get_ref();
+    check_name(src, &r.name, "[[patch]]")?;
+    let ctx = format!("[[patch]] {:?}", r.name.get_ref());
+    if !mesh_model {
+        return Err(src.invalid(
+            &p.span(),
+            format!("{ctx}: a patch pairs node sets of a mesh; the [model] must be a `mesh` or `harmony` (for matrices, place contacts with [[joint]] law = \"contact3d\")"),
+        ));
+    }
+    let sets = match &r.between.get_ref()[..] {
+        [a, b] if !a.eq_ignore_ascii_case(b) => [a.clone(), b.clone()],
+        other => {
+            return Err(src.invalid(
+                &r.between.span(),
+                format!("{ctx}: between must name two different node sets [\"A\", \"B\"] (the normal points from A into B), got {other:?}"),
+            ))
+        }
+    };
+    let law = r.law.get_ref().as_str();
+    let tangential_directions = match law {
+        "contact2d" => 1,
+        "contact3d" => 2,
+        other => {
+            return Err(
+                src.invalid(&r.law.span(), format!("{ctx}: law must be \"contact2d\" or \"contact3d\", got {other:?}"))
+            )
+        }
+    };
+    let need = |v: &Option<S<f64>>, key: &str, what: &str| -> Result<f64, StudyError> {
+        match v {
+            Some(v) => positive(src, v, &ctx, key, " N/m^3"),
+            None => Err(src.invalid(&p.span(), format!("{ctx}: needs `{key}` (N/m^3), {what}"))),
+        }
+    };
+    let normal_stiffness_per_area =
+        need(&r.normal_stiffness_per_area, "normal_stiffness_per_area", "the normal contact stiffness per unit area")?;
+    let tangential_stiffness_per_area = need(
+        &r.tangential_stiffness_per_area,
+        "tangential_stiffness_per_area",
+        "the tangential contact stiffness per unit area",
+    )?;
+    let friction = match &r.friction {
+        Some(f) => friction_coefficient(src, f, &ctx)?,
+        None => return Err(src.invalid(&p.span(), format!("{ctx}: needs `friction`, the friction coefficient μ"))),
+    };
+    let preload = match (&r.pressure, &r.preload_forces) {
+        (Some(pr), None) => {
+            let x = *pr.get_ref();
+            if !(x.is_finite() && x > 0.0) {
+                return Err(src.invalid(
+                    &pr.span(),
+                    format!("{ctx}: pressure must be > 0 Pa, got {x}: the contact would be open at rest"),
+                ));
+            }
+            PatchPreload::Pressure(x)
+        }
+        (None, Some(list)) => {
+            if list.get_ref().is_empty() || list.get_ref().len() > MAX_PRELOAD_FORCES {
+                return Err(src.invalid(
+                    &list.span(),
+                    format!("{ctx}: preload_forces must list 1 to {MAX_PRELOAD_FORCES} forces {{ set = \"BOLT\", force = [fx, fy, fz] }} (N)"),
+                ));
+            }
+            let mut forces = Vec::with_capacity(list.get_ref().len());
+            for f in list.get_ref() {
+                let f = f.get_ref();
+                forces.push((f.set.get_ref().clone(), direction(src, &f.force, &ctx, "preload_forces force")?));
+            }
+            PatchPreload::Forces(forces)
+        }
+        _ => {
+            return Err(src.invalid(
+                &p.span(),
+                format!("{ctx}: give the load at rest as exactly one of `pressure` (Pa, uniform) or `preload_forces = [{{ set = \"BOLT\", force = [fx, fy, fz] }}]` (N, a static pre-step)"),
+            ))
+        }
+    };
+    let normal = r.normal.as_ref().map(|v| direction(src, v, &ctx, "normal")).transpose()?;
+    let tangential = r.tangential.as_ref().map(|v| direction(src, v, &ctx, "tangential")).transpose()?;
+    if tangential_directions == 1 && tangential.is_none() {
+        return Err(src.invalid(
+            &r.law.span(),
+            format!("{ctx}: law \"contact2d\" needs `tangential = [x, y, z]`, the direction of sliding"),
+        ));
+    }
+    Ok(PatchSpec {
+        name: r.name.get_ref().clone(),
+        sets,
+        tangential_directions,
+        friction,
+        normal_stiffness_per_area,
+        tangential_stiffness_per_area,
+        preload,
+        normal,
+        tangential,
+        at: src.location(&r.between.span()),
+    })
 }
 
 fn excitation(src: &Source, e: &S<raw::RawExcitation>, loads: &[LoadSpec]) -> Result<ExcitationSpec, StudyError> {
