@@ -83,6 +83,10 @@ pub struct ElementAft {
     state_before: Vec<f64>,
     state_period_start: Vec<f64>,
     state_after_start: Vec<f64>,
+    /// The change of the state over the previous period, and `S` at the period's start (for
+    /// the extrapolation of a slowly repeating state, see the march).
+    previous_change: Vec<f64>,
+    sens_period_start: Vec<f64>,
     /// Slider anchor at each sample (closed-form slider Jacobian), `usize::MAX` for none.
     anchor: Vec<usize>,
     /// `(k, first marched sample)` when the last Jacobian was a slider's closed form: what
@@ -128,6 +132,8 @@ impl ElementAft {
             state_before: vec![0.0; s],
             state_period_start: vec![0.0; s],
             state_after_start: vec![0.0; s],
+            previous_change: vec![0.0; s],
+            sens_period_start: vec![0.0; s * cols],
             anchor: vec![usize::MAX; nt],
             slider_jacobian_of: None,
             weight_cos: vec![0.0; 2 * (nc / 2) + 1],
@@ -208,9 +214,15 @@ impl ElementAft {
 
         // March whole periods until the state repeats; keep the last one.
         let mut period = 0;
+        // Whether the last period started from a marched (not extrapolated) state, so that its
+        // change and this period's are successive differences of one sequence.
+        let mut previous_marched = false;
         loop {
             period += 1;
             self.state_period_start.copy_from_slice(&self.state);
+            if chain_rule {
+                self.sens_period_start.copy_from_slice(&self.sens);
+            }
             for i in 0..nt {
                 let j = (j0 + i) % nt;
                 self.load_sample(j);
@@ -256,6 +268,13 @@ impl ElementAft {
             if change <= PERIODICITY_TOLERANCE * scale.max(f64::MIN_POSITIVE) {
                 break;
             }
+            // A slider that slips little across its main slip direction (a nearly straight 2-D
+            // path) forgets its transverse position slowly: the state approaches its periodic
+            // value geometrically, w_n = w* + rⁿ e with r near 1. When two successive changes
+            // are parallel with a ratio r < 1, jump to the limit, w* = w_n + r/(1−r) Δw_n
+            // (Aitken's extrapolation), and `S` with it (it obeys the same recurrence); the
+            // next period checks the jump like any other.
+            previous_marched = !self.extrapolate_period(previous_marched, chain_rule);
             if period >= MAX_PERIODS {
                 return Err(AftError::NotPeriodic { kind: law.kind(), periods: period, change });
             }
@@ -394,6 +413,35 @@ impl ElementAft {
                 for c2 in 0..nc {
                     jac[(c, c2)] += pc * e_a[c2];
                 }
+            }
+        }
+        true
+    }
+
+    /// After a marched period that did not repeat: Aitken's jump to the periodic state (see the
+    /// march) when this period's state change and the previous one's (`previous_marched`) are
+    /// parallel and shrinking; keeps this period's change for the next call. True if it jumped.
+    fn extrapolate_period(&mut self, previous_marched: bool, chain_rule: bool) -> bool {
+        let (mut now, mut before, mut dot) = (0.0, 0.0, 0.0);
+        for m in 0..self.s {
+            let change = self.state[m] - self.state_period_start[m];
+            now += change * change;
+            before += self.previous_change[m] * self.previous_change[m];
+            dot += change * self.previous_change[m];
+            self.previous_change[m] = change;
+        }
+        let ratio = (now / before).sqrt();
+        let parallel = dot > 0.999 * (now * before).sqrt();
+        if !(previous_marched && parallel && ratio < 0.999) {
+            return false;
+        }
+        let factor = ratio / (1.0 - ratio);
+        for m in 0..self.s {
+            self.state[m] += factor * self.previous_change[m];
+        }
+        if chain_rule {
+            for (s, s0) in self.sens.iter_mut().zip(&self.sens_period_start) {
+                *s += factor * (*s - s0);
             }
         }
         true
