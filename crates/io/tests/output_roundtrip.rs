@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use stickslip_io::study::PlotFormat;
 
 use stickslip_io::output::{
-    frf_columns, frf_row, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results,
-    write_time_data, ElementRecord, LevelResult, OutputRecord, PointRecord, PointStability,
+    frf_columns, frf_row, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results, write_time_data,
+    ElementRecord, LevelResult, OutputRecord, PointRecord, PointStability,
 };
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -210,8 +210,7 @@ fn frf_npz_holds_every_column_and_harmonic_exactly_in_numpy_format() {
     let path = dir.join("frf.npz");
     write_frf_npz(&path, &levels).unwrap();
     let columns = frf_columns(&levels[0].points[0]);
-    let rows: Vec<Vec<f64>> =
-        levels.iter().flat_map(|l| l.points.iter().map(move |p| frf_row(l.level_n, p))).collect();
+    let rows: Vec<Vec<f64>> = levels.iter().flat_map(|l| l.points.iter().map(move |p| frf_row(l.level_n, p))).collect();
     let points: Vec<&PointRecord> = levels.iter().flat_map(|l| &l.points).collect();
 
     let mut zip = npyz::zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
