@@ -369,20 +369,15 @@ impl<'a> PlotJob<'a> {
 /// Draw `jobs` on the thread pool (one thread with `--threads 1`); returns their files in the
 /// order given.
 fn draw_all(jobs: Vec<PlotJob<'_>>) -> Result<Vec<PathBuf>, OutputError> {
-    if jobs.len() > 1 && jobs.iter().any(|j| j.path.extension().is_some_and(|e| e == "png")) {
-        load_font();
-    }
-    jobs.par_iter().map(|job| (job.draw)(&job.path)).collect::<Result<(), _>>()?;
+    jobs.par_iter().with_min_len(PLOTS_PER_THREAD).map(|job| (job.draw)(&job.path)).collect::<Result<(), _>>()?;
     Ok(jobs.into_iter().map(|job| job.path).collect())
 }
 
-/// Look the labels' font up once, before plots are drawn side by side. plotters keeps the
-/// font for the whole process only once a lookup has finished; plots starting together on
-/// several threads would each run the fontconfig lookup (several ms) themselves. A failure
-/// is left for the plots to report, with their file names.
-fn load_font() {
-    let _ = (FONT, 15).into_font().box_size("0");
-}
+/// Fewest plots a thread draws. Each thread that draws a PNG looks its font up through
+/// fontconfig once (plotters 0.3.7 keeps fonts per thread: its process-wide cache is read but
+/// the lookup runs all the same), which costs about as much as drawing two plots; a thread
+/// joins in only for enough plots to pay for it.
+const PLOTS_PER_THREAD: usize = 4;
 
 /// A plot `plot(dir/<stem>_<output>.<ext>, levels, output)` for every output of the levels'
 /// points.
