@@ -357,8 +357,11 @@ pub fn plot_results(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> R
 /// results, so they are drawn in parallel.
 struct PlotJob<'a> {
     path: PathBuf,
-    draw: Box<dyn Fn(&Path) -> Result<(), OutputError> + Send + Sync + 'a>,
+    draw: DrawPlot<'a>,
 }
+
+/// What draws a plot into the file it is given.
+type DrawPlot<'a> = Box<dyn Fn(&Path) -> Result<(), OutputError> + Send + Sync + 'a>;
 
 impl<'a> PlotJob<'a> {
     fn new(path: PathBuf, draw: impl Fn(&Path) -> Result<(), OutputError> + Send + Sync + 'a) -> Self {
