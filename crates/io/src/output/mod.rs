@@ -23,6 +23,7 @@ pub use csv::{
 };
 pub use manifest::{manifest_path, replace_previous_run};
 pub use npz::write_frf_npz;
+pub(crate) use npz::NpzFile;
 
 /// All converged points of one force level.
 #[derive(Clone, Debug, Default, PartialEq)]
