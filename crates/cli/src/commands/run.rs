@@ -97,69 +97,77 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     timings.push(("all levels (wall clock)".into(), elapsed.as_secs_f64()));
     let runs: Vec<LevelRun> = runs.into_iter().map(|(run, _)| run).collect();
 
-    let snapshots_started = Instant::now();
-    // A snapshot that fails does not keep the sweeps' results from being written: it is
-    // reported at the end with the incomplete levels.
-    let (snapshots, failed_snapshots): (Vec<_>, Vec<_>) = study
-        .snapshots
-        .par_iter()
-        .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
-        .partition(Result::is_ok);
-    let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
-    // The [grid] frequencies, at every level.
-    let (grid, failed_grid): (Vec<_>, Vec<_>) = if study.grid_hz.is_empty() {
-        (Vec::new(), Vec::new())
-    } else {
-        excitation
-            .levels_n
-            .par_iter()
-            .map(|&level| run_grid(&study, &model, &excitation, &outputs, level))
-            .partition(Result::is_ok)
-    };
-    let grid: Vec<_> = grid.into_iter().filter_map(Result::ok).collect();
-    if !snapshots.is_empty() || !study.grid_hz.is_empty() {
-        timings.push(("snapshots and grid".into(), snapshots_started.elapsed().as_secs_f64()));
-    }
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
     let plots = (!args.no_plots).then_some(study.output_options.plot_format);
-    // The result files and plots, and the [nonlinear_mode] backbone when the study asks for
-    // one, side by side: neither needs the other. A failed backbone is reported at the end
-    // with the incomplete levels, after everything else is written.
-    let outputs_started = Instant::now();
-    let (results, backbone) = rayon::join(
+    // The sweeps' result files and plots on one side; on the other, what is left to solve: the
+    // snapshots, the grid and the [nonlinear_mode] backbone. Neither needs the other. A failed
+    // snapshot, grid level or backbone does not keep the sweeps' results from being written:
+    // it is reported at the end with the incomplete levels.
+    let after_sweeps = Instant::now();
+    let (results, (snapshots, grid, snapshots_secs, backbone)) = rayon::join(
         || -> anyhow::Result<(Vec<PathBuf>, f64)> {
             let started = Instant::now();
-            let mut files = write_results(&args.out, &levels, plots)?;
-            files.extend(write_snapshots(&args.out, &snapshots, plots)?);
-            if !grid.is_empty() {
-                let path = args.out.join("grid.csv");
-                write_frf_csv(&path, &grid)?;
-                files.push(path);
-            }
+            let files = write_results(&args.out, &levels, plots)?;
             Ok((files, started.elapsed().as_secs_f64()))
         },
         || {
             let started = Instant::now();
-            study.nonlinear_mode.as_ref().map(|_| {
+            let snapshots: (Vec<_>, Vec<_>) = study
+                .snapshots
+                .par_iter()
+                .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
+                .partition(Result::is_ok);
+            // The [grid] frequencies, at every level.
+            let grid: (Vec<_>, Vec<_>) = if study.grid_hz.is_empty() {
+                (Vec::new(), Vec::new())
+            } else {
+                excitation
+                    .levels_n
+                    .par_iter()
+                    .map(|&level| run_grid(&study, &model, &excitation, &outputs, level))
+                    .partition(Result::is_ok)
+            };
+            let snapshots_secs = started.elapsed().as_secs_f64();
+            let started = Instant::now();
+            let backbone = study.nonlinear_mode.as_ref().map(|_| {
                 let forced = Some((excitation.pattern.as_slice(), levels.as_slice()));
                 super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet, forced)
                     .map(|files| (files, started.elapsed().as_secs_f64()))
-            })
+            });
+            (snapshots, grid, snapshots_secs, backbone)
         },
     );
     let (mut files, results_secs) = results?;
-    match &backbone {
-        Some(Ok((written, backbone_secs))) => {
-            files.extend(written.iter().cloned());
-            // Overlapping stages: their wall clock counts once in the total, each is a part of it.
-            timings.push((
-                "result files, plots and nonlinear mode (wall clock)".into(),
-                outputs_started.elapsed().as_secs_f64(),
-            ));
-            timings.push(("  result files and plots".into(), results_secs));
-            timings.push(("  nonlinear mode".into(), *backbone_secs));
+    let (snapshots, failed_snapshots) = snapshots;
+    let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
+    let (grid, failed_grid) = grid;
+    let grid: Vec<_> = grid.into_iter().filter_map(Result::ok).collect();
+    files.extend(write_snapshots(&args.out, &snapshots, plots)?);
+    if !grid.is_empty() {
+        let path = args.out.join("grid.csv");
+        write_frf_csv(&path, &grid)?;
+        files.push(path);
+    }
+    if let Some(Ok((written, _))) = &backbone {
+        files.extend(written.iter().cloned());
+    }
+    // Stages side by side: their wall clock counts once in the total, each is a part of it.
+    let solved_meanwhile = !study.snapshots.is_empty() || !study.grid_hz.is_empty();
+    let backbone_secs = match &backbone {
+        Some(Ok((_, secs))) => Some(*secs),
+        _ => None,
+    };
+    if solved_meanwhile || backbone_secs.is_some() {
+        timings.push(("after the sweeps (wall clock)".into(), after_sweeps.elapsed().as_secs_f64()));
+        timings.push(("  result files and plots".into(), results_secs));
+        if solved_meanwhile {
+            timings.push(("  snapshots and grid".into(), snapshots_secs));
         }
-        _ => timings.push(("result files and plots".into(), results_secs)),
+        if let Some(secs) = backbone_secs {
+            timings.push(("  nonlinear mode".into(), secs));
+        }
+    } else {
+        timings.push(("result files and plots".into(), results_secs));
     }
     let backbone = backbone.map(|b| b.map(|(files, _)| files));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
