@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
+use rayon::prelude::*;
 
 use crate::output::{JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
 use crate::records::{FrfSet, TimeRecords};
@@ -339,26 +340,67 @@ fn bifurcation_symbol(kind: &str) -> &'static str {
 
 /// One FRF plot per output, `dir/frf_<output>.<png|svg>`; returns the files written.
 pub fn plot_frfs(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
-    per_output(dir, levels, format, "frf", plot_frf)
+    draw_all(per_output(dir, levels, format, "frf", plot_frf))
 }
 
-/// `plot(dir/<stem>_<output>.<ext>, levels, output)` for every output of the levels' points;
-/// returns the files written.
-fn per_output(
+/// Every plot of a sweep's results: [`plot_frfs`], [`plot_frf_phases`] and
+/// [`plot_level_details`], drawn side by side on the thread pool; returns the files written,
+/// in that order.
+pub fn plot_results(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    let mut jobs = per_output(dir, levels, format, "frf", plot_frf);
+    jobs.extend(per_output(dir, levels, format, "frf_phase", plot_frf_phase));
+    jobs.extend(level_details(dir, levels, format));
+    draw_all(jobs)
+}
+
+/// A plot to draw: its file and what draws it. The plots of a run depend on nothing but the
+/// results, so they are drawn in parallel.
+struct PlotJob<'a> {
+    path: PathBuf,
+    draw: DrawPlot<'a>,
+}
+
+/// What draws a plot into the file it is given.
+type DrawPlot<'a> = Box<dyn Fn(&Path) -> Result<(), OutputError> + Send + Sync + 'a>;
+
+impl<'a> PlotJob<'a> {
+    fn new(path: PathBuf, draw: impl Fn(&Path) -> Result<(), OutputError> + Send + Sync + 'a) -> Self {
+        PlotJob { path, draw: Box::new(draw) }
+    }
+}
+
+/// Draw `jobs` on the thread pool (one thread with `--threads 1`); returns their files in the
+/// order given.
+fn draw_all(jobs: Vec<PlotJob<'_>>) -> Result<Vec<PathBuf>, OutputError> {
+    jobs.par_iter().with_min_len(PLOTS_PER_THREAD).map(|job| (job.draw)(&job.path)).collect::<Result<(), _>>()?;
+    Ok(jobs.into_iter().map(|job| job.path).collect())
+}
+
+/// Fewest plots a thread draws. Each thread that draws a PNG looks its font up through
+/// fontconfig once (plotters 0.3.7 keeps fonts per thread: its process-wide cache is read but
+/// the lookup runs all the same), which costs about as much as drawing two plots; a thread
+/// joins in only for enough plots to pay for it.
+const PLOTS_PER_THREAD: usize = 4;
+
+/// A plot `plot(dir/<stem>_<output>.<ext>, levels, output)` for every output of the levels'
+/// points.
+fn per_output<'a>(
     dir: &Path,
-    levels: &[LevelResult],
+    levels: &'a [LevelResult],
     format: PlotFormat,
     stem: &str,
     plot: fn(&Path, &[LevelResult], &str) -> Result<(), OutputError>,
-) -> Result<Vec<PathBuf>, OutputError> {
-    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Ok(Vec::new()) };
-    let mut files = Vec::new();
-    for o in &first.outputs {
-        let path = dir.join(format!("{stem}_{}.{}", o.name, format.extension()));
-        plot(&path, levels, &o.name)?;
-        files.push(path);
-    }
-    Ok(files)
+) -> Vec<PlotJob<'a>> {
+    let Some(first) = levels.iter().flat_map(|l| l.points.first()).next() else { return Vec::new() };
+    first
+        .outputs
+        .iter()
+        .map(|o| {
+            let path = dir.join(format!("{stem}_{}.{}", o.name, format.extension()));
+            let output = o.name.clone();
+            PlotJob::new(path, move |path| plot(path, levels, &output))
+        })
+        .collect()
 }
 
 /// Amplitudes of harmonics 1..N (m, log scale) of `output` against frequency (Hz) for one level.
@@ -453,15 +495,20 @@ pub fn plot_joint_sides(path: &Path, snapshot: &SnapshotResult, sides: &JointSid
 /// Fig. 17), each element's hysteresis loop (`loop_level<i>_<el>`) and slider velocity
 /// (`slider_level<i>_<el>`). Returns the files written.
 pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
+    draw_all(level_details(dir, levels, format))
+}
+
+/// The plots of [`plot_level_details`].
+fn level_details<'a>(dir: &Path, levels: &'a [LevelResult], format: PlotFormat) -> Vec<PlotJob<'a>> {
     let ext = format.extension();
-    let mut files = Vec::new();
+    let mut jobs = Vec::new();
     for (i, level) in levels.iter().enumerate() {
         let Some(p0) = level.points.first() else { continue };
         for o in &p0.outputs {
             if o.harmonics.len() > 1 {
                 let path = dir.join(format!("harmonics_level{i}_{}.{ext}", o.name));
-                plot_harmonics(&path, level, &o.name)?;
-                files.push(path);
+                let output = o.name.as_str();
+                jobs.push(PlotJob::new(path, move |path| plot_harmonics(path, level, output)));
             }
         }
         let resonance =
@@ -471,17 +518,16 @@ pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat
             });
         let Some(point) = resonance else { continue };
         for e in point.elements.iter().filter(|e| !e.loop_u.is_empty()) {
-            let path = dir.join(format!("loop_level{i}_{}.{ext}", e.name));
-            plot_hysteresis(&path, level.level_n, point, &e.name)?;
-            files.push(path);
+            let (level_n, element) = (level.level_n, e.name.as_str());
+            let path = dir.join(format!("loop_level{i}_{element}.{ext}"));
+            jobs.push(PlotJob::new(path, move |path| plot_hysteresis(path, level_n, point, element)));
             if !e.slider_velocity.is_empty() {
-                let path = dir.join(format!("slider_level{i}_{}.{ext}", e.name));
-                plot_slider_velocity(&path, level.level_n, point, &e.name)?;
-                files.push(path);
+                let path = dir.join(format!("slider_level{i}_{element}.{ext}"));
+                jobs.push(PlotJob::new(path, move |path| plot_slider_velocity(path, level_n, point, element)));
             }
         }
     }
-    Ok(files)
+    jobs
 }
 
 /// Phase of the first harmonic of `output` against the force, in degrees in (−180, 180],
@@ -520,7 +566,7 @@ pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Resu
 /// One phase plot per output, `dir/frf_phase_<output>.<png|svg>`, beside the amplitude plots of
 /// [`plot_frfs`]; returns the files written.
 pub fn plot_frf_phases(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
-    per_output(dir, levels, format, "frf_phase", plot_frf_phase)
+    draw_all(per_output(dir, levels, format, "frf_phase", plot_frf_phase))
 }
 
 /// Most points drawn per curve of a time record: a swept sine holds millions of samples, which

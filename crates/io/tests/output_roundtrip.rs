@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use stickslip_io::study::PlotFormat;
 
 use stickslip_io::output::{
-    frf_columns, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results, write_time_data,
+    frf_columns, frf_row, harmonics_from_coefficients, write_frf_csv, write_frf_npz, write_results, write_time_data,
     ElementRecord, LevelResult, OutputRecord, PointRecord, PointStability,
 };
 
@@ -197,6 +197,75 @@ fn frf_npz_reads_back_exactly() {
     assert_eq!(amps[6 * 8 + 3], levels[1].points[1].outputs[1].harmonics[3].0);
     let (_, h3) = read(&mut npz, "slider-P_h3_amp_m");
     assert_eq!(h3[6], amps[6 * 8 + 3]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every array of `frf.npz`, as `numpy.load` sees it: float64, C order, its shape, the header
+/// numpy writes, and every value equal to the table's, bit for bit.
+#[test]
+fn frf_npz_holds_every_column_and_harmonic_exactly_in_numpy_format() {
+    use std::io::Read as _;
+    let dir = scratch_dir("npz-all");
+    let levels = levels(0);
+    let path = dir.join("frf.npz");
+    write_frf_npz(&path, &levels).unwrap();
+    let columns = frf_columns(&levels[0].points[0]);
+    let rows: Vec<Vec<f64>> = levels.iter().flat_map(|l| l.points.iter().map(move |p| frf_row(l.level_n, p))).collect();
+    let points: Vec<&PointRecord> = levels.iter().flat_map(|l| &l.points).collect();
+
+    let mut zip = npyz::zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
+    let mut names: Vec<String> = zip.file_names().map(String::from).collect();
+    names.sort();
+    let mut expected: Vec<String> = columns.iter().map(|c| format!("{c}.npy")).collect();
+    for out in ["mass", "slider-P"] {
+        expected.extend([format!("{out}_harmonics_amp_m.npy"), format!("{out}_harmonics_phase_rad.npy")]);
+    }
+    expected.sort();
+    assert_eq!(names, expected);
+    // The header as numpy writes it (format 1.0, the dict padded with spaces to a multiple of 16).
+    let mut bytes = Vec::new();
+    zip.by_name("level_N.npy").unwrap().read_to_end(&mut bytes).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+    assert_eq!((10 + header_len) % 16, 0);
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert_eq!(header.trim_end(), "{'descr': '<f8', 'fortran_order': False, 'shape': (8, ), }");
+    assert!(header.ends_with('\n'));
+    assert_eq!(bytes.len(), 10 + header_len + 8 * 8);
+
+    let mut npz = npyz::npz::NpzArchive::open(&path).unwrap();
+    let mut read = |name: &str| {
+        let arr = npz.by_name(name).unwrap().unwrap_or_else(|| panic!("array {name} missing"));
+        assert_eq!(arr.dtype(), npyz::DType::Plain("<f8".parse().unwrap()), "{name}");
+        assert_eq!(arr.order(), npyz::Order::C, "{name}");
+        let shape = arr.shape().to_vec();
+        (shape, arr.into_vec::<f64>().unwrap())
+    };
+    for (c, name) in columns.iter().enumerate() {
+        let (shape, values) = read(name);
+        assert_eq!(shape, [rows.len() as u64], "{name}");
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&values), bits(&rows.iter().map(|r| r[c]).collect::<Vec<_>>()), "{name}");
+    }
+    for (o, out) in ["mass", "slider-P"].iter().enumerate() {
+        let (shape, amps) = read(&format!("{out}_harmonics_amp_m"));
+        let (phase_shape, phases) = read(&format!("{out}_harmonics_phase_rad"));
+        assert_eq!(shape, [8, 8]);
+        assert_eq!(phase_shape, [8, 8]);
+        let harmonics: Vec<(f64, f64)> = points.iter().flat_map(|p| p.outputs[o].harmonics.iter().copied()).collect();
+        assert_eq!(amps, harmonics.iter().map(|h| h.0).collect::<Vec<_>>());
+        assert_eq!(phases, harmonics.iter().map(|h| h.1).collect::<Vec<_>>());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_empty_sweep_writes_an_empty_npz() {
+    let dir = scratch_dir("npz-empty");
+    let path = dir.join("frf.npz");
+    write_frf_npz(&path, &[]).unwrap();
+    let zip = npyz::zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
+    assert_eq!(zip.len(), 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -97,52 +97,79 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     timings.push(("all levels (wall clock)".into(), elapsed.as_secs_f64()));
     let runs: Vec<LevelRun> = runs.into_iter().map(|(run, _)| run).collect();
 
-    let snapshots_started = Instant::now();
-    // A snapshot that fails does not keep the sweeps' results from being written: it is
-    // reported at the end with the incomplete levels.
-    let (snapshots, failed_snapshots): (Vec<_>, Vec<_>) = study
-        .snapshots
-        .par_iter()
-        .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
-        .partition(Result::is_ok);
-    let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
-    // The [grid] frequencies, at every level.
-    let (grid, failed_grid): (Vec<_>, Vec<_>) = if study.grid_hz.is_empty() {
-        (Vec::new(), Vec::new())
-    } else {
-        excitation
-            .levels_n
-            .par_iter()
-            .map(|&level| run_grid(&study, &model, &excitation, &outputs, level))
-            .partition(Result::is_ok)
-    };
-    let grid: Vec<_> = grid.into_iter().filter_map(Result::ok).collect();
-    if !snapshots.is_empty() || !study.grid_hz.is_empty() {
-        timings.push(("snapshots and grid".into(), snapshots_started.elapsed().as_secs_f64()));
-    }
-    let written = Instant::now();
-
     let levels: Vec<_> = runs.iter().map(|r| r.result.clone()).collect();
     let plots = (!args.no_plots).then_some(study.output_options.plot_format);
-    let mut files = write_results(&args.out, &levels, plots)?;
+    // The sweeps' result files and plots on one side; on the other, what is left to solve: the
+    // snapshots, the grid and the [nonlinear_mode] backbone. Neither needs the other. A failed
+    // snapshot, grid level or backbone does not keep the sweeps' results from being written:
+    // it is reported at the end with the incomplete levels.
+    let after_sweeps = Instant::now();
+    let (results, (snapshots, grid, snapshots_secs, backbone)) = rayon::join(
+        || -> anyhow::Result<(Vec<PathBuf>, f64)> {
+            let started = Instant::now();
+            let files = write_results(&args.out, &levels, plots)?;
+            Ok((files, started.elapsed().as_secs_f64()))
+        },
+        || {
+            let started = Instant::now();
+            let snapshots: (Vec<_>, Vec<_>) = study
+                .snapshots
+                .par_iter()
+                .map(|s| run_snapshot(&study, &model, &excitation, &outputs, s))
+                .partition(Result::is_ok);
+            // The [grid] frequencies, at every level.
+            let grid: (Vec<_>, Vec<_>) = if study.grid_hz.is_empty() {
+                (Vec::new(), Vec::new())
+            } else {
+                excitation
+                    .levels_n
+                    .par_iter()
+                    .map(|&level| run_grid(&study, &model, &excitation, &outputs, level))
+                    .partition(Result::is_ok)
+            };
+            let snapshots_secs = started.elapsed().as_secs_f64();
+            let started = Instant::now();
+            let backbone = study.nonlinear_mode.as_ref().map(|_| {
+                let forced = Some((excitation.pattern.as_slice(), levels.as_slice()));
+                super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet, forced)
+                    .map(|files| (files, started.elapsed().as_secs_f64()))
+            });
+            (snapshots, grid, snapshots_secs, backbone)
+        },
+    );
+    let (mut files, results_secs) = results?;
+    let (snapshots, failed_snapshots) = snapshots;
+    let snapshots: Vec<_> = snapshots.into_iter().filter_map(Result::ok).collect();
+    let (grid, failed_grid) = grid;
+    let grid: Vec<_> = grid.into_iter().filter_map(Result::ok).collect();
     files.extend(write_snapshots(&args.out, &snapshots, plots)?);
     if !grid.is_empty() {
         let path = args.out.join("grid.csv");
         write_frf_csv(&path, &grid)?;
         files.push(path);
     }
-    timings.push(("result files and plots".into(), written.elapsed().as_secs_f64()));
-    // The [nonlinear_mode] backbone, when the study asks for one; a failure is reported at the
-    // end with the incomplete levels, after everything else is written.
-    let backbone_started = Instant::now();
-    let backbone = study.nonlinear_mode.as_ref().map(|_| {
-        let forced = Some((excitation.pattern.as_slice(), levels.as_slice()));
-        super::nlmode::compute_and_write(&study, &model, &outputs, &args.out, plots, args.quiet, forced)
-    });
-    if let Some(Ok(written)) = &backbone {
+    if let Some(Ok((written, _))) = &backbone {
         files.extend(written.iter().cloned());
-        timings.push(("nonlinear mode".into(), backbone_started.elapsed().as_secs_f64()));
     }
+    // Stages side by side: their wall clock counts once in the total, each is a part of it.
+    let solved_meanwhile = !study.snapshots.is_empty() || !study.grid_hz.is_empty();
+    let backbone_secs = match &backbone {
+        Some(Ok((_, secs))) => Some(*secs),
+        _ => None,
+    };
+    if solved_meanwhile || backbone_secs.is_some() {
+        timings.push(("after the sweeps (wall clock)".into(), after_sweeps.elapsed().as_secs_f64()));
+        timings.push(("  result files and plots".into(), results_secs));
+        if solved_meanwhile {
+            timings.push(("  snapshots and grid".into(), snapshots_secs));
+        }
+        if let Some(secs) = backbone_secs {
+            timings.push(("  nonlinear mode".into(), secs));
+        }
+    } else {
+        timings.push(("result files and plots".into(), results_secs));
+    }
+    let backbone = backbone.map(|b| b.map(|(files, _)| files));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
         "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, peaks.csv{}, points/)",

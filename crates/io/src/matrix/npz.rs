@@ -7,10 +7,10 @@ use std::io::Write;
 use std::path::Path;
 
 use faer::Mat;
-use npyz::WriterBuilder;
 use stickslip_core::model::{Damping, LinearModel};
 
 use super::MatrixFileError;
+use crate::output::NpzFile;
 
 /// What goes in the archive besides M, K, D.
 pub struct NpzExtras<'a> {
@@ -23,13 +23,11 @@ pub struct NpzExtras<'a> {
 /// Write `M`, `K`, `D` (if a damping matrix), the DOF map and the extras.
 pub fn write(path: &Path, model: &LinearModel, extras: &NpzExtras<'_>) -> Result<(), MatrixFileError> {
     let io = |e: std::io::Error| MatrixFileError::io(path, e);
-    let mut npz = npyz::npz::NpzWriter::create(path).map_err(io)?;
-    let mut dense = |name: &str, m: &Mat<f64>| -> std::io::Result<()> {
+    let mut npz = NpzFile::create(path).map_err(io)?;
+    let mut dense = |name: &str, m: &Mat<f64>| {
         let shape = [m.nrows() as u64, m.ncols() as u64];
-        let mut w = npz.array::<f64>(name, Default::default())?.default_dtype().shape(&shape).begin_nd()?;
         // C order: row by row.
-        w.extend((0..m.nrows()).flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)])))?;
-        w.finish()
+        npz.add(name, &shape, (0..m.nrows()).flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)])))
     };
     dense("M", &model.mass.to_dense()).map_err(io)?;
     dense("K", &model.stiffness.to_dense()).map_err(io)?;
@@ -39,20 +37,13 @@ pub fn write(path: &Path, model: &LinearModel, extras: &NpzExtras<'_>) -> Result
     if let Some(t) = extras.basis {
         dense("T", t).map_err(io)?;
     }
-    let mut ints = |name: &str, v: &[i64]| -> std::io::Result<()> {
-        let mut w = npz.array::<i64>(name, Default::default())?.default_dtype().shape(&[v.len() as u64]).begin_nd()?;
-        w.extend(v.iter().copied())?;
-        w.finish()
-    };
     let nodes: Vec<i64> = model.dofs.iter().map(|d| d.node.map(|n| n as i64).unwrap_or(-1)).collect();
     let dirs: Vec<i64> = model.dofs.iter().map(|d| d.direction.map(|n| n as i64).unwrap_or(-1)).collect();
     let retained: Vec<i64> = extras.retained.iter().map(|&i| i as i64).collect();
-    ints("dof_node", &nodes).map_err(io)?;
-    ints("dof_direction", &dirs).map_err(io)?;
-    ints("retained_index", &retained).map_err(io)?;
-    // Finish explicitly (writes the zip directory) so that errors are reported, not dropped.
-    let mut file = npz.zip_writer().finish().map_err(|e| io(std::io::Error::other(e)))?;
-    file.flush().map_err(io)
+    for (name, ints) in [("dof_node", nodes), ("dof_direction", dirs), ("retained_index", retained)] {
+        npz.add(name, &[ints.len() as u64], ints).map_err(io)?;
+    }
+    npz.finish().map_err(io)
 }
 
 /// The DOF map as CSV: `index,name,node,direction,full_index` (node and direction empty for

@@ -23,6 +23,7 @@ pub use csv::{
 };
 pub use manifest::{manifest_path, replace_previous_run};
 pub use npz::write_frf_npz;
+pub(crate) use npz::NpzFile;
 
 /// All converged points of one force level.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -187,6 +188,19 @@ pub fn write_results(
     plots: Option<PlotFormat>,
 ) -> Result<Vec<PathBuf>, OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.to_path_buf(), source })?;
+    // The plots take longer than the tables: they are drawn meanwhile, on the other threads.
+    let (tables, plotted) = rayon::join(
+        || write_tables(dir, levels),
+        || plots.map_or(Ok(Vec::new()), |format| crate::plot::plot_results(dir, levels, format)),
+    );
+    let mut files = tables?;
+    files.extend(plotted?);
+    Ok(files)
+}
+
+/// The tables of [`write_results`]; returns their files.
+#[cfg(feature = "plot")]
+fn write_tables(dir: &std::path::Path, levels: &[LevelResult]) -> Result<Vec<PathBuf>, OutputError> {
     let (csv, npz) = (dir.join("frf.csv"), dir.join("frf.npz"));
     write_frf_csv(&csv, levels)?;
     write_frf_npz(&npz, levels)?;
@@ -199,11 +213,6 @@ pub fn write_results(
         files.push(path);
     }
     write_time_data(dir, levels)?;
-    if let Some(format) = plots {
-        files.extend(crate::plot::plot_frfs(dir, levels, format)?);
-        files.extend(crate::plot::plot_frf_phases(dir, levels, format)?);
-        files.extend(crate::plot::plot_level_details(dir, levels, format)?);
-    }
     Ok(files)
 }
 
