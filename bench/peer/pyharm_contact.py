@@ -42,28 +42,89 @@ LC = 1e-4  # m, adimensioning length (x amplitude scale; N0 / k_n = 2.5e-5 m, sl
 WC = 2.0 * np.pi * 195.0  # rad/s, stuck tangential mode
 
 
-def system_input(band_hz, ds, solver, reductor, max_points=None, f_y=F_Y):
-    # One node, components 0 = x (tangential), 1 = y (normal), 2 = z (second tangential, unforced).
-    eye = np.eye(3)
+def matrices(cells):
+    """M, K, D of `cells` nodes of 3 components (x, y, z), node-major: each DOF has its mass,
+    spring to the ground and dashpot; with several cells, springs K_GROUND join the same component
+    of neighbouring nodes (a chain)."""
+    n = 3 * cells
+    m = MASS * np.eye(n)
+    k = K_GROUND * np.eye(n)
+    for i in range(cells - 1):
+        for c in range(3):
+            a, b = 3 * i + c, 3 * (i + 1) + c
+            k[np.ix_([a, b], [a, b])] += K_GROUND * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    return m, k, DAMPING * np.eye(n)
+
+
+def system_input(band_hz, ds, solver, reductor, max_points=None, f_y=F_Y, cells=1):
+    # Node i, components 0 = x (tangential), 1 = y (normal), 2 = z (second tangential, unforced).
+    m, k, d = matrices(cells)
+    connectors = {}
+    for i in range(cells):
+        # Against the ground; dirs[0] is the normal, dirs[1:] the tangential directions.
+        connectors[f"contact{i}"] = {"type": "Penalty3D", "connect": {"body": [i]}, "dirs": [1, 0, 2], "mu": MU,
+                                     "N0": N0, "k_n": K_N, "k_t": K_T, "g": 0.0}
+        connectors[f"force_x{i}"] = {"type": "CosinusForcing", "connect": {"body": [i]}, "dirs": [0], "amp": F_X}
+        connectors[f"force_y{i}"] = {"type": "CosinusForcing", "connect": {"body": [i]}, "dirs": [1], "amp": -f_y}
     return {
         "export": {"status": False},
         "system": {"type": "Base", "nh": HARMONICS, "nti": SAMPLES, "adim": {"status": True, "lc": LC, "wc": WC}},
-        "substructures": {
-            "body": {
-                "type": "substructure",
-                "ndofs": 3,
-                "matrix": {"M": MASS * eye, "K": K_GROUND * eye, "C": DAMPING * eye},
-            }
-        },
-        "connectors": {
-            # Against the ground; dirs[0] is the normal, dirs[1:] the tangential directions.
-            "contact": {"type": "Penalty3D", "connect": {"body": [0]}, "dirs": [1, 0, 2], "mu": MU, "N0": N0,
-                        "k_n": K_N, "k_t": K_T, "g": 0.0},
-            "force_x": {"type": "CosinusForcing", "connect": {"body": [0]}, "dirs": [0], "amp": F_X},
-            "force_y": {"type": "CosinusForcing", "connect": {"body": [0]}, "dirs": [1], "amp": -f_y},
-        },
+        "substructures": {"body": {"type": "substructure", "ndofs": 3, "matrix": {"M": m, "K": k, "C": d}}},
+        "connectors": connectors,
         "analysis": {"frf": analysis_options(band_hz[0], band_hz[1], ds, solver, reductor, max_points)},
     }
+
+
+def write_study(path, cells, f_y=F_Y):
+    """The same chain as a stickslip study (x and y of each cell; z is pyHarm's unforced third
+    component and is left out)."""
+    dofs = [f"{c}{i}" for i in range(cells) for c in "xy"]
+    n = len(dofs)
+    k = K_GROUND * np.eye(n)
+    for i in range(cells - 1):
+        for c in range(2):
+            a, b = 2 * i + c, 2 * (i + 1) + c
+            k[np.ix_([a, b], [a, b])] += K_GROUND * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    rows = ",\n    ".join("[" + ", ".join(f"{v:.1f}" for v in row) + "]" for row in k)
+    lines = [
+        f"# {cells} cells of the 2-D contact case (studies/contact2d.toml) in a chain: springs of",
+        "# 1e6 N/m join the x DOFs and the y DOFs of neighbouring cells; every cell has its contact",
+        "# and its forces. Written by pyharm_contact.py --cells N --write-study.",
+        "[model]",
+        "dofs = [" + ", ".join(f'"{d}"' for d in dofs) + "]",
+        f"mass = [{', '.join(['1.0'] * n)}]",
+        f"stiffness = [\n    {rows}]",
+        "",
+        "[damping]",
+        f"alpha = {DAMPING / MASS}",
+        "",
+        "[[load]]",
+        'name = "shaker"',
+        "values = [" + ", ".join(f"{F_X if c == 'x' else f_y}" for i in range(cells) for c in "xy") + "]",
+        "",
+    ]
+    for i in range(cells):
+        lines += [
+            "[[joint]]",
+            f'name = "contact{i}"',
+            'law = "contact2d"',
+            f'tangential = [["x{i}"]]',
+            f'normal = ["y{i}"]',
+            f"preload = {N0}",
+            f"normal_stiffness = {K_N}",
+            f"tangential_stiffness = {K_T}",
+            f"friction = {MU}",
+            "",
+        ]
+    lines += [
+        "[excitation]", 'load = "shaker"', "levels = [1.0]", "",
+        "[sweep]", f"start_hz = {BAND_HZ[0]}", f"end_hz = {BAND_HZ[1]}", "",
+        "[harmonic_balance]", f"harmonics = {HARMONICS}", f"samples = {SAMPLES}", "",
+        "[[output]]", 'name = "x"', 'dof = "x0"', "",
+        "[[output]]", 'name = "y"', 'dof = "y0"', "",
+    ]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
 
 
 if __name__ == "__main__":
@@ -75,9 +136,15 @@ if __name__ == "__main__":
     p.add_argument("--csv-y", default=None, help="FRF of y (default: the x file with _x -> _y)")
     p.add_argument("--force-y", type=float, default=F_Y, help="force on y, N (60 opens the contact)")
     p.add_argument("--band", type=float, nargs=2, default=BAND_HZ, metavar=("LO", "HI"))
+    p.add_argument("--cells", type=int, default=1, help="cells in a chain (q = 2 cells contact directions)")
+    p.add_argument("--write-study", default=None, help="write the stickslip study of this model and stop")
     args = p.parse_args()
-    inp = system_input(tuple(args.band), args.ds, args.solver, args.reductor, args.max_points, args.force_y)
-    maestro = main(args, f"2-D contact (Penalty3D), F_y = {args.force_y:g} N, N = 7, 300 samples, "
+    if args.write_study:
+        write_study(args.write_study, args.cells, args.force_y)
+        raise SystemExit(0)
+    inp = system_input(tuple(args.band), args.ds, args.solver, args.reductor, args.max_points, args.force_y,
+                       args.cells)
+    maestro = main(args, f"2-D contact (Penalty3D), {args.cells} cell(s), F_y = {args.force_y:g} N, N = 7, 300 samples, "
                    f"{args.band[0]:g}-{args.band[1]:g} Hz", inp, 0, tuple(args.band), LC, WC)
     points, _ = collect(maestro, 1, LC, WC)
     csv_y = args.csv_y or args.csv.replace("_x", "_y")
