@@ -51,7 +51,8 @@ for c in 2 4 8; do
     $ONE "$PY" time_contact.py --stickslip $SS --study studies/contact2d_chain$c.toml --cells $c --ds $ds \
         > results/contact_chain${c}_interleaved.txt
 done
-# The opening case (60 N on y): pyHarm's Penalty3D stops after the first points.
+# pyHarm's cost per residual and Jacobian evaluation against the number of contacts.
 $ONE "$PY" pyharm_contact_evals.py --cells 1 2 4 8 > results/contact_evals_one_core.txt
+# The opening case (60 N on y): pyHarm's Penalty3D stops after the first points.
 $ONE "$PY" pyharm_contact.py --runs 1 --no-warmup --force-y 60 --ds 0.02 --max-points 40 \
     --csv /tmp/pyharm_contact_open_x.csv > results/contact_open_one_core.txt || true
