@@ -2,7 +2,7 @@
 # Runs every pyHarm peer measurement and keeps the printed reports in results/.
 # Needs pyHarm in a throwaway virtualenv (not a project dependency):
 #   python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install pyharm-os==1.2.2
-# Usage: bash bench/peer/run_all.sh [PYTHON]   (about 75 minutes on the loaded 2-core machine)
+# Usage: bash bench/peer/run_all.sh [PYTHON]   (about 90 minutes on the loaded 2-core machine)
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${1:-/tmp/pyharm-venv/bin/python}
