@@ -248,3 +248,4 @@ def main(args, label, inp, out_dof_index, f_band_hz, lc, wc, warmup_inp=None):
     print(f"peak: {freqs[ipk]:.4f} Hz, amplitude {amps[ipk]:.6e} m")
     print(f"max solver residual norm (adimensional): {max(p['residual'] for p in points):.2e}")
     print(f"FRF written to {args.csv}")
+    return maestro
