@@ -150,7 +150,8 @@ fn face_area(x: &[[f64; 3]]) -> (f64, [f64; 3]) {
 
 /// The boundary faces of the mesh whose nodes all lie in `members` (indexed by mesh node).
 fn surface_faces(mesh: &Mesh, members: &[bool]) -> Vec<Face> {
-    let mut seen: std::collections::HashMap<Vec<usize>, (usize, Option<Face>)> = std::collections::HashMap::new();
+    // Ordered, so that the areas (sums over faces) round the same on every run.
+    let mut seen: std::collections::BTreeMap<Vec<usize>, (usize, Option<Face>)> = std::collections::BTreeMap::new();
     for s in &mesh.solids {
         let centroid = {
             let corners = &s.nodes[..s.kind.n_corners()];
