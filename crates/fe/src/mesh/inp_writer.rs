@@ -662,28 +662,8 @@ fn point_id(p: &PointElement) -> u64 {
 fn rotation_nodes(mesh: &Mesh) -> Vec<Option<u64>> {
     let nn = mesh.nodes.len();
     let carries = nodes_with_rotations(mesh);
-    let mut named = vec![false; nn];
-    for p in &mesh.points {
-        match *p {
-            PointElement::Spring { a, dir_a, b, .. } => {
-                named[a] |= dir_a > 3;
-                if let Some((b, db)) = b {
-                    named[b] |= db > 3;
-                }
-            }
-            PointElement::Connector { a, b, stiffness, .. } if stiffness[3..].iter().any(|k| *k != 0.0) => {
-                named[a] = true;
-                if let Some(b) = b {
-                    named[b] = true;
-                }
-            }
-            _ => {}
-        }
-    }
+    let mut named = rotations_named_by_points_and_equations(mesh);
     for &(n, d) in &mesh.fixed {
-        named[n] |= d > 3;
-    }
-    for &(n, d, _) in mesh.equations.iter().flat_map(|e| &e.terms) {
         named[n] |= d > 3;
     }
     let mut rigid = vec![None::<bool>; nn];
@@ -713,10 +693,16 @@ fn rotation_nodes(mesh: &Mesh) -> Vec<Option<u64>> {
 /// Nodes that carry rotational DOFs in the assembled model: reference nodes of couplings and
 /// nodes whose rotations a spring, connector or equation names (as the DOF map decides).
 fn nodes_with_rotations(mesh: &Mesh) -> Vec<bool> {
-    let mut rot = vec![false; mesh.nodes.len()];
+    let mut rot = rotations_named_by_points_and_equations(mesh);
     for c in &mesh.couplings {
         rot[c.reference] = true;
     }
+    rot
+}
+
+/// Nodes whose rotations a spring, a connector's rotational component or an equation names.
+fn rotations_named_by_points_and_equations(mesh: &Mesh) -> Vec<bool> {
+    let mut rot = vec![false; mesh.nodes.len()];
     for p in &mesh.points {
         match *p {
             PointElement::Spring { a, dir_a, b, .. } => {
@@ -734,10 +720,8 @@ fn nodes_with_rotations(mesh: &Mesh) -> Vec<bool> {
             _ => {}
         }
     }
-    for e in &mesh.equations {
-        for &(n, d, _) in &e.terms {
-            rot[n] |= d > 3;
-        }
+    for &(n, d, _) in mesh.equations.iter().flat_map(|e| &e.terms) {
+        rot[n] |= d > 3;
     }
     rot
 }
