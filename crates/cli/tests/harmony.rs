@@ -30,6 +30,8 @@ fn harmony_softens_and_flattens_with_the_level_while_friction_dissipates() {
     // mesh_writers tests).
     let deck = std::fs::read_to_string(out.join("model.inp")).unwrap();
     assert!(deck.contains("*NODE") && deck.contains("*COUPLING") && deck.contains("*ELEMENT, TYPE=C3D20"));
+    // The screws' moment springs act on the rotation nodes of rigid bodies, as CalculiX takes them.
+    assert!(deck.contains("ROT NODE=") && !deck.contains("springs act on translations only"));
     let msh = std::fs::read_to_string(out.join("model.msh")).unwrap();
     assert!(msh.starts_with("$MeshFormat\n4.1") && msh.contains("ACCELEROMETERS"));
     let table = std::fs::read_to_string(out.join("frf.csv")).unwrap();

@@ -3,11 +3,12 @@
 //! harmonic balance branch, one where the blades stick and two where they slip.
 //!
 //! With 1e10 N/m joints both methods converge slowly (the paper's Section 4.4: a stiff contact
-//! makes the harmonic balance depend on N). Measured at 239 and 251 Hz: the harmonic balance
-//! with N = 7 is 1.6-1.9 % above N = 25, N = 15 within 0.2 % of it; Newmark with 256 steps per
-//! period is 0.9 % below 2048 steps, 1024 steps within 0.1 %. The comparison is therefore made
-//! at N = 25 and 1024 steps, where the two independent methods meet within 0.5 % (measured:
-//! 0.03 % at 245 Hz, 0.3 % at 252 Hz).
+//! makes the harmonic balance depend on N). Measured at 239 and 251 Hz (docs/harmony.md): the
+//! harmonic balance with N = 7 is 1.6-1.9 % above N = 25, N = 15 within 0.7 % of it; Newmark
+//! with 256 steps per period is up to 0.8 % below 2048 steps, 1024 steps within 0.2 %. The
+//! comparison is therefore made at N = 25 and 1024 steps, where the two independent methods
+//! meet within 0.5 % (measured with the previous 100 mm shaker insert: 0.03 % at 245 Hz, 0.3 %
+//! at 252 Hz).
 mod common;
 use common::{repo, scratch, stickslip};
 

@@ -197,6 +197,50 @@ fn kinematic_coupling_keywords_build_the_same_model() {
 }
 
 #[test]
+fn rigid_body_rotation_node_stands_for_the_reference_rotations() {
+    // CalculiX's form of a rotational spring on a rigid body: the ROT NODE's DOFs 1-3 are the
+    // reference's rotations, so a spring on its DOF 1 and a held DOF 2 are the reference's θ_x
+    // spring and held θ_y.
+    let base = "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 1., 1., 0.\n4, 0., 0., 1.\n100, 0.3, 0.3, 0.3\n\
+                *ELEMENT, TYPE=C3D4, ELSET=E\n1, 1, 2, 3, 4\n*NSET, NSET=TOP\n4, 3\n\
+                *MATERIAL, NAME=S\n*ELASTIC\n1e9, 0.3\n*DENSITY\n1000.\n*SOLID SECTION, ELSET=E, MATERIAL=S\n\
+                *BOUNDARY\n1, 1, 3\n2, 2, 3\n";
+    let spring =
+        |node: u64, dof: u8| format!("*ELEMENT, TYPE=SPRING1, ELSET=K\n7, {node}\n*SPRING, ELSET=K\n{dof}\n2.5e6\n");
+    let direct = format!("{base}*RIGID BODY, NSET=TOP, REF NODE=100\n{}*BOUNDARY\n100, 5\n", spring(100, 4));
+    let rotation_node = format!(
+        "{}{}*BOUNDARY\n101, 2\n*RIGID BODY, NSET=TOP, REF NODE=100, ROT NODE=101\n",
+        base.replace("100, 0.3, 0.3, 0.3\n", "100, 0.3, 0.3, 0.3\n101, 0.3, 0.3, 0.3\n"),
+        spring(101, 1)
+    );
+    let read = inp::parse(&rotation_node, "rot.inp").unwrap();
+    assert!(read.node(101).is_none(), "the rotation node leaves the mesh");
+    let a = FeModel::assemble(inp::parse(&direct, "direct.inp").unwrap()).unwrap();
+    let b = FeModel::assemble(read).unwrap();
+    assert_eq!(a.model.dofs, b.model.dofs);
+    assert!(a.model.dofs.iter().all(|d| d.name != "100.5"), "θ_y held");
+    let (ka, kb) = (a.model.stiffness.to_dense(), b.model.stiffness.to_dense());
+    assert!((&ka - &kb).norm_max() <= 1e-15 * ka.norm_max());
+    assert_eq!(a.model.mass.to_dense(), b.model.mass.to_dense());
+
+    // What a rotation node cannot carry is refused, naming the rigid body's line.
+    let with_rot = base.replace("100, 0.3, 0.3, 0.3\n", "100, 0.3, 0.3, 0.3\n101, 0.3, 0.3, 0.3\n");
+    let rigid = "*RIGID BODY, NSET=TOP, REF NODE=100, ROT NODE=101\n";
+    for (extra, expected) in [
+        (spring(101, 4), "spring element 7 acts on DOF 4 of node 101, the ROT NODE of REF NODE=100"),
+        ("*ELEMENT, TYPE=MASS, ELSET=M\n8, 101\n*MASS, ELSET=M\n1.\n".to_string(), "mass element 8 is on node 101"),
+        ("*BOUNDARY\n101, 6\n".to_string(), "*BOUNDARY acts on DOF 6 of node 101"),
+    ] {
+        let err = inp::parse(&format!("{with_rot}{extra}{rigid}"), "bad.inp").unwrap_err().to_string();
+        assert!(err.contains(expected) && err.contains("bad.inp:"), "{err}");
+    }
+    let err = inp::parse(&format!("{base}*RIGID BODY, NSET=TOP, REF NODE=100, ROT NODE=100\n"), "same.inp")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("ROT NODE=100 is the REF NODE"), "{err}");
+}
+
+#[test]
 fn element_face_surfaces_collect_corner_and_mid_edge_nodes() {
     // A C3D10 and a C3D20 in one deck; face S1 of each, coupled to reference nodes.
     let deck = "*NODE\n1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n5, .5, 0., 0.\n6, .5, .5, 0.\n\

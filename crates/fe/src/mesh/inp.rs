@@ -181,6 +181,10 @@ struct Parser {
     material_at: Vec<Origin>,
     /// The last `*COUPLING` waiting for its `*KINEMATIC`: reference node, nodes, origin.
     coupling: Option<(usize, Vec<usize>, Origin)>,
+    /// `*RIGID BODY` rotation nodes: rotation node → (its reference node, origin). CalculiX
+    /// gives a rigid body's rotations to the translations 1-3 of its ROT NODE; here they are the
+    /// reference node's DOFs 4-6, so the rotation nodes leave the mesh once the deck is read.
+    rotation_nodes: BTreeMap<usize, (usize, Origin)>,
 }
 
 /// The numbers of a data line (empty fields skipped).
@@ -201,6 +205,7 @@ impl Parser {
             current_material: None,
             material_at: Vec::new(),
             coupling: None,
+            rotation_nodes: BTreeMap::new(),
         }
     }
 
@@ -544,14 +549,13 @@ impl Parser {
                 let rid = self.num::<u64>(kw, rid, "a reference node id")?;
                 let reference = self.node_ref(kw, rid, &what)?;
                 if name == "RIGID BODY" {
-                    if params.contains_key("ROT NODE") {
-                        return Err(self.syntax(
-                            kw,
-                            "*RIGID BODY with ROT NODE is not supported; the reference node carries the rotations",
-                        ));
-                    }
                     let set = required("NSET")?;
                     let nodes = self.nodes_of(kw, set, &what)?;
+                    if let Some(rot) = param("ROT NODE") {
+                        let rot = self.num::<u64>(kw, rot, "a rotation node id")?;
+                        let rot = self.node_ref(kw, rot, "*RIGID BODY, ROT NODE=")?;
+                        self.rotation_node(kw, rot, reference)?;
+                    }
                     self.mesh.couplings.push(RigidCoupling {
                         reference,
                         nodes,
@@ -608,6 +612,112 @@ impl Parser {
             k if IGNORED.contains(&k) => {}
             _ => return Err(MeshError::UnknownKeyword { at: self.at(kw), keyword: name.clone() }),
         }
+        Ok(())
+    }
+
+    /// Record `rot` as the rotation node of `reference` (one rotation node per reference; a
+    /// reference may head several rigid bodies with the same one).
+    fn rotation_node(&mut self, kw: &Line, rot: usize, reference: usize) -> Result<(), MeshError> {
+        let id = |n: usize| self.mesh.nodes[n].id;
+        if rot == reference {
+            return Err(self.syntax(kw, format!("ROT NODE={} is the REF NODE: expected a node of its own", id(rot))));
+        }
+        if let Some((&other, _)) = self.rotation_nodes.iter().find(|(&r, (f, _))| *f == reference && r != rot) {
+            return Err(self.syntax(
+                kw,
+                format!(
+                    "REF NODE={} already has ROT NODE={}: expected the same rotation node",
+                    id(reference),
+                    id(other)
+                ),
+            ));
+        }
+        if self.rotation_nodes.contains_key(&reference) {
+            return Err(self.syntax(kw, format!("REF NODE={} is another rigid body's ROT NODE", id(reference))));
+        }
+        match self.rotation_nodes.get(&rot) {
+            Some((r, _)) if *r != reference => {
+                Err(self
+                    .syntax(kw, format!("ROT NODE={} already carries the rotations of REF NODE={}", id(rot), id(*r))))
+            }
+            _ => {
+                self.rotation_nodes.insert(rot, (reference, self.at(kw)));
+                Ok(())
+            }
+        }
+    }
+
+    /// Move what acts on rotation nodes' translations to their references' rotations (DOF
+    /// d → d + 3), then drop the rotation nodes. A rotation node takes springs, boundary
+    /// conditions and equation terms on DOFs 1-3 only: anything else on it (a solid, a mass, an
+    /// axial spring, a coupling, a rotation DOF) has no meaning and is an error.
+    fn resolve_rotation_nodes(&mut self) -> Result<(), MeshError> {
+        if self.rotation_nodes.is_empty() {
+            return Ok(());
+        }
+        let rot = &self.rotation_nodes;
+        let nodes = &self.mesh.nodes;
+        let misuse = |n: usize, what: String| {
+            let (r, at) = &rot[&n];
+            MeshError::Syntax {
+                at: at.clone(),
+                msg: format!(
+                    "{what} node {}, the ROT NODE of REF NODE={}: a rotation node takes only springs, \
+                     *BOUNDARY and *EQUATION terms on its DOFs 1-3 (the reference's rotations)",
+                    nodes[n].id, nodes[*r].id
+                ),
+            }
+        };
+        let map = |n: usize, d: u8, what: &dyn Fn() -> String| -> Result<(usize, u8), MeshError> {
+            match rot.get(&n) {
+                None => Ok((n, d)),
+                Some(&(r, _)) if d <= 3 => Ok((r, d + 3)),
+                Some(_) => Err(misuse(n, format!("{} acts on DOF {d} of", what()))),
+            }
+        };
+        if let Some(s) = self.mesh.solids.iter().find(|s| s.nodes.iter().any(|n| rot.contains_key(n))) {
+            let n = *s.nodes.iter().find(|n| rot.contains_key(n)).expect("found above");
+            return Err(misuse(n, format!("solid element {} uses", s.id)));
+        }
+        for p in &mut self.mesh.points {
+            match p {
+                PointElement::Spring { id, a, dir_a, b, .. } => {
+                    let what = || format!("spring element {id}");
+                    (*a, *dir_a) = map(*a, *dir_a, &what)?;
+                    if let Some((b, db)) = b {
+                        (*b, *db) = map(*b, *db, &what)?;
+                    }
+                }
+                PointElement::Mass { id, node: n, .. } if rot.contains_key(n) => {
+                    return Err(misuse(*n, format!("mass element {id} is on")))
+                }
+                PointElement::AxialSpring { id, a, b, .. } => {
+                    if let Some(n) = [*a, *b].into_iter().find(|n| rot.contains_key(n)) {
+                        return Err(misuse(n, format!("SPRINGA element {id} uses")));
+                    }
+                }
+                _ => {}
+            }
+        }
+        for (n, d) in &mut self.mesh.fixed {
+            (*n, *d) = map(*n, *d, &|| "*BOUNDARY".to_string())?;
+        }
+        for e in &mut self.mesh.equations {
+            let at = e.at.clone();
+            for (n, d, _) in &mut e.terms {
+                (*n, *d) = map(*n, *d, &|| format!("the *EQUATION at {at}"))?;
+            }
+        }
+        for c in &self.mesh.couplings {
+            if let Some(n) = std::iter::once(&c.reference).chain(&c.nodes).find(|n| rot.contains_key(n)) {
+                return Err(misuse(*n, format!("the coupling at {} uses", c.at)));
+            }
+        }
+        let mut drop = vec![false; self.mesh.nodes.len()];
+        for &n in self.rotation_nodes.keys() {
+            drop[n] = true;
+        }
+        self.mesh.remove_nodes(&drop);
         Ok(())
     }
 
@@ -810,9 +920,10 @@ impl Parser {
                 refs.iter().filter_map(|r| if let ElemRef::Solid(s) = r { Some(*s) } else { None }).collect();
             self.mesh.element_sets.insert(name.clone(), solids);
         }
-        for (name, nodes) in self.surfaces {
+        for (name, nodes) in std::mem::take(&mut self.surfaces) {
             self.mesh.node_sets.entry(name).or_insert(nodes);
         }
+        self.resolve_rotation_nodes()?;
         Ok(self.mesh)
     }
 }

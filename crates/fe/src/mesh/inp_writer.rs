@@ -20,6 +20,17 @@
 //! slave nodes that carry rotations (see [`super::RigidCoupling`]); for those they are written
 //! as `*EQUATION`s `θ_s − θ_r = 0`, which eliminate the same DOFs.
 //!
+//! A reference node whose rotations something else names (a rotational spring or connector
+//! component, a fixed rotation, an equation term: the screws' moment stiffness and the shaker's
+//! held rotations of the Harmony model) is written as CalculiX honours it, provided its couplings
+//! all tie the three translations: `*RIGID BODY, NSET=, REF NODE=, ROT NODE=` on the union of
+//! their slave nodes, with a new rotation node (at the reference's position, ids above every node
+//! id) whose DOFs 1–3 stand for the reference's rotations 4–6 in every spring, `*BOUNDARY` and
+//! `*EQUATION` of the deck. A rigid body also ties the rotations of slaves that carry them (as
+//! Abaqus and the stickslip reader take it), so such couplings are written this way only when
+//! they tie those rotations too. The reader maps the rotation nodes back and drops them, so the
+//! round trip still gives the same model.
+//!
 //! Numbers: CalculiX reads the first 20 characters of a numeric field (Fortran `f20.0`) and
 //! takes a stiffness line under `*SPRING` without a decimal point for a DOF line, so every real
 //! is written with a decimal point in at most 20 characters ([`format_real`]). It keeps the
@@ -33,16 +44,16 @@
 //!
 //! CalculiX 2.20 runs the decks of meshes whose springs, connectors and equations act on
 //! translations (checked by hand on the rewritten reference decks of `crates/fe/reference/`:
-//! the same frequencies as the original decks).
-//! Its springs act on translations only, and nodes other than the reference nodes of couplings
-//! have no rotations there: springs, connector components and equations on DOFs 4–6 are
+//! the same frequencies as the original decks) or on the rotations of references written as
+//! rigid bodies (the Harmony deck, `crates/fe/reference/harmony_coarse.freq`). Other nodes have
+//! no rotations there: springs, connector components and equations on their DOFs 4–6 are
 //! written as Abaqus and the stickslip reader take them (with a comment in the deck saying so),
 //! and CalculiX ignores or rejects them.
 //!
 //! The deck adds sets of its own, named so as not to collide with the mesh's: one element set
 //! per solid kind (`C3D8`, ...), one per material when no existing set fits (`SOLIDS_<name>`),
 //! one per point element (`MASS_<id>`, `SPRING_<id>`, `SPRINGA_<id>`, `CONNECTOR_<id>_<dof>`)
-//! and a node set per coupling whose slaves match no node set (`COUPLING_<n>`); reading the deck
+//! and a node set per coupling or rigid body whose slaves match no node set (`COUPLING_<n>`); reading the deck
 //! back gives the mesh's sets plus these. Point element ids are kept unless one collides with a
 //! solid id or another point element's id: then all point elements are numbered from the
 //! largest solid id + 1. Connector components after the first take new ids above every id.
@@ -73,7 +84,13 @@ pub fn write(mesh: &Mesh, path: impl AsRef<Path>) -> Result<(), MeshError> {
 /// The deck for `mesh`.
 pub fn to_string(mesh: &Mesh) -> Result<String, MeshError> {
     check(mesh)?;
-    let mut deck = Deck { mesh, out: String::new(), names: Names::new(mesh), equations: Vec::new() };
+    let mut deck = Deck {
+        mesh,
+        out: String::new(),
+        names: Names::new(mesh),
+        equations: Vec::new(),
+        rotation_nodes: rotation_nodes(mesh),
+    };
     deck.header();
     deck.nodes();
     let kind_sets = deck.solids();
@@ -253,6 +270,8 @@ struct Deck<'a> {
     names: Names,
     /// Equations made for coupled rotations, written after the mesh's own.
     equations: Vec<Vec<(usize, u8, f64)>>,
+    /// Id of each node's rotation node, for the references written as `*RIGID BODY`.
+    rotation_nodes: Vec<Option<u64>>,
 }
 
 impl Deck<'_> {
@@ -263,6 +282,20 @@ impl Deck<'_> {
 
     fn node_id(&self, n: usize) -> u64 {
         self.mesh.nodes[n].id
+    }
+
+    /// The deck's node and DOF for DOF `d` of node `n`: a rotation of a reference with a
+    /// rotation node is that node's translation.
+    fn dof(&self, n: usize, d: u8) -> (u64, u8) {
+        match self.rotation_nodes[n] {
+            Some(rot) if d > 3 => (rot, d - 3),
+            _ => (self.node_id(n), d),
+        }
+    }
+
+    /// Whether DOF `d` of node `n` is a rotation CalculiX has no DOF for.
+    fn rotation_without_node(&self, n: usize, d: u8) -> bool {
+        d > 3 && self.rotation_nodes[n].is_none()
     }
 
     /// Ids, at most [`PER_LINE`] a line.
@@ -294,6 +327,16 @@ impl Deck<'_> {
         for node in &self.mesh.nodes {
             let [x, y, z] = node.xyz.map(format_real);
             let _ = writeln!(self.out, "{}, {x}, {y}, {z}", node.id);
+        }
+        if self.rotation_nodes.iter().any(Option::is_some) {
+            self.line("** Rotation nodes of the *RIGID BODY cards: their DOFs 1-3 are the rotations");
+            self.line("** (DOFs 4-6) of the reference nodes at the same places.");
+            for (n, rot) in self.rotation_nodes.iter().enumerate() {
+                if let Some(rot) = rot {
+                    let [x, y, z] = self.mesh.nodes[n].xyz.map(format_real);
+                    let _ = writeln!(self.out, "{rot}, {x}, {y}, {z}");
+                }
+            }
         }
     }
 
@@ -406,8 +449,13 @@ impl Deck<'_> {
             }
         };
         let rotational = mesh.points.iter().any(|p| match *p {
-            PointElement::Spring { dir_a, b, .. } => dir_a > 3 || b.is_some_and(|(_, d)| d > 3),
-            PointElement::Connector { stiffness, .. } => stiffness[3..].iter().any(|k| *k != 0.0),
+            PointElement::Spring { a, dir_a, b, .. } => {
+                self.rotation_without_node(a, dir_a) || b.is_some_and(|(b, d)| self.rotation_without_node(b, d))
+            }
+            PointElement::Connector { a, b, stiffness, .. } => {
+                stiffness[3..].iter().any(|k| *k != 0.0)
+                    && (self.rotation_without_node(a, 4) || b.is_some_and(|b| self.rotation_without_node(b, 4)))
+            }
             _ => false,
         });
         if rotational {
@@ -453,24 +501,25 @@ impl Deck<'_> {
 
     /// A SPRING1 (to ground) or SPRING2 element in its own set, with its `*SPRING` card: the DOF
     /// line, then the stiffness (with a decimal point, which tells CalculiX it is not a DOF).
+    /// Rotations of references with a rotation node act on that node's translations.
     fn spring(&mut self, eid: u64, set: &str, a: (usize, u8), b: Option<(usize, u8)>, k: f64) {
-        let na = self.node_id(a.0);
+        let (na, da) = self.dof(a.0, a.1);
         match b {
             None => {
                 let _ = writeln!(self.out, "*ELEMENT, TYPE=SPRING1, ELSET={set}\n{eid}, {na}");
-                let _ = writeln!(self.out, "*SPRING, ELSET={set}\n{}\n{}", a.1, format_real(k));
+                let _ = writeln!(self.out, "*SPRING, ELSET={set}\n{da}\n{}", format_real(k));
             }
             Some((b, db)) => {
-                let nb = self.node_id(b);
+                let (nb, db) = self.dof(b, db);
                 let _ = writeln!(self.out, "*ELEMENT, TYPE=SPRING2, ELSET={set}\n{eid}, {na}, {nb}");
-                let _ = writeln!(self.out, "*SPRING, ELSET={set}\n{}, {db}\n{}", a.1, format_real(k));
+                let _ = writeln!(self.out, "*SPRING, ELSET={set}\n{da}, {db}\n{}", format_real(k));
             }
         }
     }
 
     /// `node, first, last` lines, consecutive DOFs of a node merged (the order is kept).
     fn boundaries(&mut self) {
-        let fixed = &self.mesh.fixed;
+        let fixed: Vec<(u64, u8)> = self.mesh.fixed.iter().map(|&(n, d)| self.dof(n, d)).collect();
         if fixed.is_empty() {
             return;
         }
@@ -483,14 +532,32 @@ impl Deck<'_> {
                 last += 1;
                 i += 1;
             }
-            let _ = writeln!(self.out, "{}, {first}, {last}", self.node_id(n));
+            let _ = writeln!(self.out, "{n}, {first}, {last}");
             i += 1;
+        }
+    }
+
+    /// A node set holding exactly `slaves`: an existing named one, else `COUPLING_<c + 1>`.
+    fn slave_set(&mut self, c: usize, slaves: &BTreeSet<usize>) -> String {
+        let mesh = self.mesh;
+        let existing = mesh.node_sets.iter().find(|(name, nodes)| {
+            name.parse::<u64>().is_err() && nodes.len() == slaves.len() && nodes.iter().all(|n| slaves.contains(n))
+        });
+        match existing {
+            Some((name, _)) => name.clone(),
+            None => {
+                let name = self.names.unique(&format!("COUPLING_{}", c + 1));
+                let _ = writeln!(self.out, "*NSET, NSET={name}");
+                self.id_lines(slaves.iter().map(|&s| mesh.nodes[s].id));
+                name
+            }
         }
     }
 
     fn couplings(&mut self) {
         let mesh = self.mesh;
         let rotations = nodes_with_rotations(mesh);
+        let mut rigid_body_written = vec![false; mesh.nodes.len()];
         for (c, coupling) in mesh.couplings.iter().enumerate() {
             let r = coupling.reference;
             let slaves: BTreeSet<usize> = coupling.nodes.iter().copied().filter(|&s| s != r).collect();
@@ -499,21 +566,22 @@ impl Deck<'_> {
                 continue;
             }
             let translations: Vec<u8> = dofs.iter().copied().filter(|&d| d <= 3).collect();
-            if !translations.is_empty() {
-                let existing = mesh.node_sets.iter().find(|(name, nodes)| {
-                    name.parse::<u64>().is_err()
-                        && nodes.len() == slaves.len()
-                        && nodes.iter().all(|n| slaves.contains(n))
-                });
-                let set = match existing {
-                    Some((name, _)) => name.clone(),
-                    None => {
-                        let name = self.names.unique(&format!("COUPLING_{}", c + 1));
-                        let _ = writeln!(self.out, "*NSET, NSET={name}");
-                        self.id_lines(slaves.iter().map(|&s| mesh.nodes[s].id));
-                        name
-                    }
-                };
+            if let Some(rot) = self.rotation_nodes[r] {
+                // All couplings of `r` tie every translation (see `rotation_nodes`): one rigid
+                // body on all their slaves is the same constraint.
+                if !std::mem::replace(&mut rigid_body_written[r], true) {
+                    let all: BTreeSet<usize> = mesh
+                        .couplings
+                        .iter()
+                        .filter(|k| k.reference == r)
+                        .flat_map(|k| k.nodes.iter().copied())
+                        .filter(|&s| s != r)
+                        .collect();
+                    let set = self.slave_set(c, &all);
+                    let _ = writeln!(self.out, "*RIGID BODY, NSET={set}, REF NODE={}, ROT NODE={rot}", self.node_id(r));
+                }
+            } else if !translations.is_empty() {
+                let set = self.slave_set(c, &slaves);
                 let _ = writeln!(self.out, "*SURFACE, NAME={set}, TYPE=NODE\n{set}");
                 let _ = writeln!(
                     self.out,
@@ -531,6 +599,9 @@ impl Deck<'_> {
                     i += 1;
                 }
             }
+            if self.rotation_nodes[r].is_some() {
+                continue;
+            }
             for &s in slaves.iter().filter(|&&s| rotations[s]) {
                 for &d in dofs.iter().filter(|&&d| d > 3) {
                     self.equations.push(vec![(s, d, 1.0), (r, d, -1.0)]);
@@ -546,7 +617,7 @@ impl Deck<'_> {
         if all.is_empty() {
             return;
         }
-        if all.iter().flatten().any(|&(_, d, _)| d > 3) {
+        if all.iter().flatten().any(|&(n, d, _)| self.rotation_without_node(n, d)) {
             self.line("** Equations on DOFs 4-6 tie rotations, for Abaqus and stickslip; CalculiX 2.20");
             self.line("** has rotations only at the reference nodes of couplings and may reject them.");
         }
@@ -555,8 +626,13 @@ impl Deck<'_> {
             let _ = writeln!(self.out, "{}", terms.len());
             // Four terms a line (12 fields), as Abaqus reads them.
             for chunk in terms.chunks(4) {
-                let line: Vec<String> =
-                    chunk.iter().map(|&(n, d, c)| format!("{}, {d}, {}", mesh.nodes[n].id, format_real(c))).collect();
+                let line: Vec<String> = chunk
+                    .iter()
+                    .map(|&(n, d, c)| {
+                        let (id, d) = self.dof(n, d);
+                        format!("{id}, {d}, {}", format_real(c))
+                    })
+                    .collect();
                 self.line(&line.join(", "));
             }
         }
@@ -577,13 +653,56 @@ fn point_id(p: &PointElement) -> u64 {
     }
 }
 
+/// The rotation node id of each reference node written as a `*RIGID BODY` (else `None`): those
+/// whose rotations the deck names elsewhere (a spring, connector, fixed DOF or equation on DOFs
+/// 4-6, or the coupled rotations of a slave that carries rotations), since CalculiX has rotation
+/// DOFs only on a rigid body's ROT NODE, and whose couplings all tie what a rigid body ties: the
+/// three translations, and the three rotations of slaves that carry rotations. New ids above
+/// every node id, in the order of the references.
+fn rotation_nodes(mesh: &Mesh) -> Vec<Option<u64>> {
+    let nn = mesh.nodes.len();
+    let carries = nodes_with_rotations(mesh);
+    let mut named = rotations_named_by_points_and_equations(mesh);
+    for &(n, d) in &mesh.fixed {
+        named[n] |= d > 3;
+    }
+    let mut rigid = vec![None::<bool>; nn];
+    for c in &mesh.couplings {
+        let r = c.reference;
+        if c.nodes.iter().all(|&s| s == r) || c.dofs.is_empty() {
+            continue;
+        }
+        named[r] |= c.dofs.iter().any(|&d| d > 3) && c.nodes.iter().any(|&s| s != r && carries[s]);
+        // A rigid body ties the translations, and the rotations of slaves that carry them.
+        let slaves_rotate = c.nodes.iter().any(|&s| s != r && carries[s]);
+        let as_rigid_body =
+            (1..=3).all(|d| c.dofs.contains(&d)) && (!slaves_rotate || (4..=6).all(|d| c.dofs.contains(&d)));
+        rigid[r] = Some(rigid[r].unwrap_or(true) && as_rigid_body);
+    }
+    let mut next = mesh.nodes.iter().map(|n| n.id).max().unwrap_or(0);
+    (0..nn)
+        .map(|n| {
+            (named[n] && rigid[n] == Some(true)).then(|| {
+                next += 1;
+                next
+            })
+        })
+        .collect()
+}
+
 /// Nodes that carry rotational DOFs in the assembled model: reference nodes of couplings and
 /// nodes whose rotations a spring, connector or equation names (as the DOF map decides).
 fn nodes_with_rotations(mesh: &Mesh) -> Vec<bool> {
-    let mut rot = vec![false; mesh.nodes.len()];
+    let mut rot = rotations_named_by_points_and_equations(mesh);
     for c in &mesh.couplings {
         rot[c.reference] = true;
     }
+    rot
+}
+
+/// Nodes whose rotations a spring, a connector's rotational component or an equation names.
+fn rotations_named_by_points_and_equations(mesh: &Mesh) -> Vec<bool> {
+    let mut rot = vec![false; mesh.nodes.len()];
     for p in &mesh.points {
         match *p {
             PointElement::Spring { a, dir_a, b, .. } => {
@@ -601,10 +720,8 @@ fn nodes_with_rotations(mesh: &Mesh) -> Vec<bool> {
             _ => {}
         }
     }
-    for e in &mesh.equations {
-        for &(n, d, _) in &e.terms {
-            rot[n] |= d > 3;
-        }
+    for &(n, d, _) in mesh.equations.iter().flat_map(|e| &e.terms) {
+        rot[n] |= d > 3;
     }
     rot
 }

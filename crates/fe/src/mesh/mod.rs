@@ -225,6 +225,62 @@ impl Mesh {
         set.dedup();
     }
 
+    /// Remove the nodes flagged in `drop` (indexed like [`Mesh::nodes`]), renumbering the
+    /// indices everything else holds. The dropped nodes leave the node sets; no solid, point
+    /// element, fixed DOF, coupling or equation may refer to them (the caller checks).
+    pub fn remove_nodes(&mut self, drop: &[bool]) {
+        let mut new_index = vec![usize::MAX; self.nodes.len()];
+        let mut kept = Vec::with_capacity(self.nodes.len());
+        for (n, node) in std::mem::take(&mut self.nodes).into_iter().enumerate() {
+            if !drop[n] {
+                new_index[n] = kept.len();
+                kept.push(node);
+            }
+        }
+        self.nodes = kept;
+        self.node_index = self.nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
+        let at = |n: usize| {
+            let i = new_index[n];
+            assert!(i != usize::MAX, "a removed node is still referred to");
+            i
+        };
+        for s in &mut self.solids {
+            s.nodes.iter_mut().for_each(|n| *n = at(*n));
+        }
+        for p in &mut self.points {
+            match p {
+                PointElement::Mass { node, .. } => *node = at(*node),
+                PointElement::Spring { a, b, .. } => {
+                    *a = at(*a);
+                    if let Some((b, _)) = b {
+                        *b = at(*b);
+                    }
+                }
+                PointElement::AxialSpring { a, b, .. } => {
+                    *a = at(*a);
+                    *b = at(*b);
+                }
+                PointElement::Connector { a, b, .. } => {
+                    *a = at(*a);
+                    if let Some(b) = b {
+                        *b = at(*b);
+                    }
+                }
+            }
+        }
+        for set in self.node_sets.values_mut() {
+            *set = set.iter().filter(|&&n| !drop[n]).map(|&n| new_index[n]).collect();
+        }
+        self.fixed.iter_mut().for_each(|(n, _)| *n = at(*n));
+        for c in &mut self.couplings {
+            c.reference = at(c.reference);
+            c.nodes.iter_mut().for_each(|n| *n = at(*n));
+        }
+        for e in &mut self.equations {
+            e.terms.iter_mut().for_each(|(n, _, _)| *n = at(*n));
+        }
+    }
+
     /// Sorted, unique nodes used by the solids.
     pub fn solid_nodes(&self) -> Vec<usize> {
         let mut used = vec![false; self.nodes.len()];
