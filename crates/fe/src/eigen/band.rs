@@ -17,9 +17,10 @@ use stickslip_core::model::Modes;
 
 use super::{default_shift, lanczos, EigenError, EigenOptions, EigenSolution, ShiftedFactor};
 
-/// Most modes computed at one shift; wider bands are split. The Lanczos basis grows as three
-/// times the modes wanted and its orthogonalisation as their square, while a new shift costs one
-/// numeric factorisation: 300 modes of a 25,830-DOF slab take 1.2 factorisations' time each.
+/// Most modes computed at one shift; wider bands are split. The Lanczos basis holds three times
+/// the modes wanted (memory `3 count n`) and its orthogonalisation grows as their square, while
+/// a new shift costs one numeric factorisation; 300 is the largest count measured at one shift
+/// (BENCHMARKS.md, "Many modes").
 pub const MODES_PER_SHIFT: usize = 300;
 
 /// Relative widening of the band's ends before their inertia is taken, so that an eigenvalue
@@ -51,30 +52,8 @@ pub fn solve_band_split(
     opts: &EigenOptions,
     per_shift: usize,
 ) -> Result<EigenSolution, EigenError> {
-    lanczos::check_sizes(k, m)?;
-    if !(lower.is_finite() && upper.is_finite()) {
-        return Err(EigenError::Band(format!("the ends must be finite, got [{lower}, {upper}] rad^2/s^2")));
-    }
-    if lower < 0.0 {
-        return Err(EigenError::Band(format!("the lower end must be >= 0, got {lower} rad^2/s^2")));
-    }
-    if upper < lower {
-        return Err(EigenError::Band(format!(
-            "the lower end must not exceed the upper one, got [{lower}, {upper}] rad^2/s^2"
-        )));
-    }
-    super::check_mass(m, None)?;
     let n = k.nrows();
-    // Upper end first, then the lower one, so that the factor left is the lower end's: the shift
-    // of a band with nothing below it. One factor is held at a time (symbolic analysis shared).
-    let (mut factor, hi) = factor_at_end(k, m, upper, 1.0)?;
-    let lo_start = if lower == 0.0 { default_shift(k, m).min(0.0) } else { lower };
-    let lo = if lower == 0.0 {
-        // Below every eigenvalue of a positive semidefinite pair, rigid-body modes included.
-        refactor_nudged(&mut factor, k, m, &[lo_start, 2.0 * lo_start, 4.0 * lo_start])?
-    } else {
-        refactor_nudged(&mut factor, k, m, &END_WIDENING.map(|w| lower * (1.0 - w)))?
-    };
+    let (mut factor, lo, hi) = band_ends(k, m, lower, upper)?;
     let mut parts = Parts { omega: Vec::new(), shapes: Vec::new(), residuals: Vec::new(), solves: 0, restarts: 0 };
     let mut first_shift = None;
     solve_part(k, m, &mut factor, lo, hi, opts, per_shift.max(1), &mut parts, &mut first_shift)?;
@@ -91,6 +70,52 @@ pub fn solve_band_split(
         solves: parts.solves,
         restarts: parts.restarts,
     })
+}
+
+/// The number of eigenvalues `ω²` of `(K, M)` in `[lower, upper]` (rad²/s², as for
+/// [`solve_band`]), from the inertia of `K − σM` at both ends alone: no mode is computed.
+pub fn count_in_band(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    lower: f64,
+    upper: f64,
+) -> Result<usize, EigenError> {
+    let (_, lo, hi) = band_ends(k, m, lower, upper)?;
+    Ok(hi.1.saturating_sub(lo.1))
+}
+
+/// The band checked, and the inertia at its widened ends: the factor left is the lower end's.
+#[allow(clippy::type_complexity)]
+fn band_ends(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    lower: f64,
+    upper: f64,
+) -> Result<(ShiftedFactor, (f64, usize), (f64, usize)), EigenError> {
+    lanczos::check_sizes(k, m)?;
+    if !(lower.is_finite() && upper.is_finite()) {
+        return Err(EigenError::Band(format!("the ends must be finite, got [{lower}, {upper}] rad^2/s^2")));
+    }
+    if lower < 0.0 {
+        return Err(EigenError::Band(format!("the lower end must be >= 0, got {lower} rad^2/s^2")));
+    }
+    if upper < lower {
+        return Err(EigenError::Band(format!(
+            "the lower end must not exceed the upper one, got [{lower}, {upper}] rad^2/s^2"
+        )));
+    }
+    super::check_mass(m, None)?;
+    // Upper end first, then the lower one, so that the factor left is the lower end's: the shift
+    // of a band with nothing below it. One factor is held at a time (symbolic analysis shared).
+    let (mut factor, hi) = factor_at_end(k, m, upper, 1.0)?;
+    let lo = if lower == 0.0 {
+        // Below every eigenvalue of a positive semidefinite pair, rigid-body modes included.
+        let s = default_shift(k, m).min(0.0);
+        refactor_nudged(&mut factor, k, m, &[s, 2.0 * s, 4.0 * s])?
+    } else {
+        refactor_nudged(&mut factor, k, m, &END_WIDENING.map(|w| lower * (1.0 - w)))?
+    };
+    Ok((factor, lo, hi))
 }
 
 struct Parts {

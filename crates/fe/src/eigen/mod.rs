@@ -14,7 +14,7 @@ pub mod ordering;
 mod product;
 mod update;
 
-pub use band::{solve_band, solve_band_split, MODES_PER_SHIFT};
+pub use band::{count_in_band, solve_band, solve_band_split, MODES_PER_SHIFT};
 pub use factor::{ShiftInvert, ShiftedFactor};
 pub use product::{symmetric_product, symmetric_times};
 pub use update::LowRankUpdate;
