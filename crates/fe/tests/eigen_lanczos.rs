@@ -237,3 +237,142 @@ fn low_rank_update_equals_a_new_factorisation() {
     // Cutting the grounded chain leaves its far part free: singular at σ = 0.
     assert!(matches!(eigen::LowRankUpdate::new(&factor, direction(i), &[2.0 * k]), Err(EigenError::Singular { .. })));
 }
+
+/// ω² of the dense solution of `(K, M)` (faer's dense symmetric eigensolver on
+/// `L⁻¹ K L⁻ᵀ`, `M = L Lᵀ`), lowest first; rigid-body modes at ±round-off.
+fn dense_lambda(k: &faer::sparse::SparseColMat<usize, f64>, m: &faer::sparse::SparseColMat<usize, f64>) -> Vec<f64> {
+    use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+    let n = k.nrows();
+    let (kd, md) = (k.to_dense(), m.to_dense());
+    let llt = md.llt(faer::Side::Lower).unwrap();
+    let mut x = kd.clone();
+    solve_lower_triangular_in_place(llt.L(), x.as_mut(), faer::Par::Seq);
+    let mut a = x.transpose().to_owned();
+    solve_lower_triangular_in_place(llt.L(), a.as_mut(), faer::Par::Seq);
+    let a = faer::Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let (mut lambda, _) = stickslip_core::model::symmetric_eigen(a.as_ref()).unwrap();
+    lambda.sort_by(f64::total_cmp);
+    lambda
+}
+
+/// The band's modes equal the dense eigenvalues in `[lower, upper]`: same count, ω within
+/// 1e-9 relative (absolute against the first elastic mode for rigid-body modes), residuals
+/// checked, M-orthonormal across the parts of a split band.
+fn assert_band_equals_dense(
+    k: &faer::sparse::SparseColMat<usize, f64>,
+    m: &faer::sparse::SparseColMat<usize, f64>,
+    dense: &[f64],
+    (lower, upper): (f64, f64),
+    per_shift: usize,
+) -> usize {
+    let sol = eigen::solve_band_split(k, m, lower, upper, &EigenOptions::default(), per_shift).unwrap();
+    let expected: Vec<f64> = dense.iter().copied().filter(|&l| l >= lower && l <= upper).collect();
+    // Dense rigid-body modes come out at ±round-off: inside a band from 0.
+    let expected: Vec<f64> =
+        if lower == 0.0 { dense.iter().copied().filter(|&l| l <= upper).collect() } else { expected };
+    assert_eq!(sol.modes.omega.len(), expected.len(), "band [{lower:e}, {upper:e}], {per_shift} per shift");
+    let elastic = dense.iter().copied().find(|&l| l > 1e-6 * dense[dense.len() - 1]).unwrap().sqrt();
+    for (r, (w, e)) in sol.modes.omega.iter().zip(&expected).enumerate() {
+        let e = e.max(0.0).sqrt();
+        if e < 1e-6 * elastic {
+            assert!(*w < 1e-5 * elastic, "rigid mode {r}: {w} rad/s");
+        } else {
+            assert!((w / e - 1.0).abs() < 1e-9, "mode {r} of the band: {w} vs {e} rad/s");
+        }
+    }
+    // Residuals: 1e-7 for elastic modes (the Ritz residual of the shift-invert operator, 1e-10,
+    // grows with the distance to the shift); a rigid-body mode's `Kφ` vanishes and its
+    // residual is measured against `|σ| ‖Mφ‖`, σ ~1e-4 of the frequencies of interest: the
+    // solver's limit, 1e-6.
+    for (r, (res, w)) in sol.residuals.iter().zip(&sol.modes.omega).enumerate() {
+        let limit = if *w < 1e-5 * elastic { 1e-6 } else { 1e-7 };
+        assert!(*res < limit, "mode {r} of the band ({w} rad/s): residual {res:.1e}");
+    }
+    let phi = &sol.modes.shapes;
+    let g = phi.transpose() * (Matrix::Sparse(m.clone()).to_dense() * phi);
+    for i in 0..g.nrows() {
+        for j in 0..g.ncols() {
+            let e = if i == j { 1.0 } else { 0.0 };
+            assert!((g[(i, j)] - e).abs() < 1e-8, "Φᵀ M Φ ({i},{j}) = {}", g[(i, j)]);
+        }
+    }
+    sol.modes.omega.len()
+}
+
+#[test]
+fn band_equals_the_dense_modes_in_it_on_a_3d_lattice() {
+    let (k, m) = lattice_3d(4, 3, 5, 5.0e5);
+    let d = dense_lambda(&k, &m);
+    let mid = |i: usize| 0.5 * (d[i] + d[i + 1]);
+    // Between modes 30 and 61 (1-based), at one shift and split in five.
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (mid(29), mid(59)), 300), 30);
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (mid(29), mid(59)), 7), 30);
+    // Ends on eigenvalues: both included.
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (d[40], d[50]), 300), 11);
+    // From 0: the lowest modes, without a count.
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (0.0, mid(9)), 300), 10);
+    // The whole spectrum.
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (0.0, 2.0 * d[d.len() - 1]), 300), d.len());
+}
+
+/// A square grid: every eigenvalue with i ≠ j is (at least) double.
+#[test]
+fn band_finds_every_copy_of_repeated_eigenvalues() {
+    let (k, m, mut exact) = laplacian_2d(20, 20);
+    exact.sort_by(f64::total_cmp);
+    let repeated = exact.windows(2).filter(|w| (w[1] / w[0] - 1.0).abs() < 1e-12).count();
+    assert!(repeated > 100, "{repeated}");
+    for (lo, hi, per_shift) in
+        [(0.0, exact[60] * 1.0001, 300), (exact[100], exact[180], 300), (exact[100], exact[180], 13)]
+    {
+        assert_band_equals_dense(&k, &m, &exact, (lo, hi), per_shift);
+    }
+}
+
+/// A free-free steel cube (hex8, 192 DOFs): 6 rigid-body modes at 0 and the cube's repeated
+/// elastic modes, in bands from 0 (rigid modes only, then with elastic ones) and above.
+#[test]
+fn band_from_zero_includes_the_six_rigid_modes_of_a_free_free_cube() {
+    use stickslip_fe::assembly::FeModel;
+    use stickslip_fe::element::SolidKind;
+    use stickslip_fe::mesh::generate::box_mesh;
+    use stickslip_fe::mesh::Material;
+    let steel = Material { young: 2.1e11, poisson: 0.3, density: 7800.0 };
+    let fe = FeModel::assemble(box_mesh([0.1, 0.1, 0.1], [3, 3, 3], SolidKind::Hex8, steel)).unwrap();
+    let (k, m) = (eigen::to_sparse(&fe.model.stiffness).into_owned(), eigen::to_sparse(&fe.model.mass).into_owned());
+    let d = dense_lambda(&k, &m);
+    assert!(d[5] < 1e-6 * d[6] && d[6] > 0.0, "{:?}", &d[..8]);
+    // Band ends between distinct eigenvalues: the cube's are double and triple.
+    let gap = |mut i: usize| {
+        while d[i + 1] - d[i] < 1e-6 * d[i + 1] {
+            i += 1;
+        }
+        i
+    };
+    let mid = |i: usize| 0.5 * (d[gap(i)] + d[gap(i) + 1]);
+    let repeated = d[6..].windows(2).filter(|w| w[1] - w[0] < 1e-9 * w[1]).count();
+    assert!(repeated > 20, "{repeated}");
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (0.0, mid(5)), 300), 6);
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (0.0, mid(29)), 300), gap(29) + 1);
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (0.0, mid(29)), 8), gap(29) + 1);
+    assert_eq!(assert_band_equals_dense(&k, &m, &d, (mid(19), mid(79)), 300), gap(79) - gap(19));
+}
+
+#[test]
+fn band_without_modes_is_empty_and_bad_ends_are_errors() {
+    let (k, m) = lattice_3d(4, 3, 5, 5.0e5);
+    let d = dense_lambda(&k, &m);
+    let (lo, hi) = (0.6 * d[30] + 0.4 * d[31], 0.3 * d[30] + 0.7 * d[31]);
+    let sol = eigen::solve_band(&k, &m, lo, hi, &EigenOptions::default()).unwrap();
+    assert!(sol.modes.omega.is_empty() && sol.residuals.is_empty() && sol.modes.shapes.ncols() == 0);
+    assert_eq!(sol.below_shift, 31);
+    for (lo, hi, says) in [
+        (-1.0, 10.0, "lower end must be >= 0"),
+        (10.0, 1.0, "must not exceed the upper"),
+        (f64::NAN, 1.0, "finite"),
+        (0.0, f64::INFINITY, "finite"),
+    ] {
+        let e = eigen::solve_band(&k, &m, lo, hi, &EigenOptions::default()).unwrap_err();
+        assert!(matches!(e, EigenError::Band(_)) && e.to_string().contains(says), "{e}");
+    }
+}

@@ -102,6 +102,46 @@ fn a_mesh_builds_and_its_free_mode_reduction_keeps_the_lowest_modes() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `modes_up_to_hz` keeps every mode up to the frequency, counted by the inertia of K − σM:
+/// free modes of the whole bar for "free", fixed-interface modes for "cb"; with `modes` it is
+/// refused, and so is a frequency below the first free mode or not > 0.
+#[test]
+fn modes_up_to_a_frequency_are_counted_not_guessed() {
+    let dir = scratch_dir("mesh-up-to");
+    std::fs::write(dir.join("bar.inp"), bar_inp()).unwrap();
+    std::fs::write(dir.join("full.toml"), format!("[model]\nmesh = \"bar.inp\"\n{REST}")).unwrap();
+    let (full, _, _) = Study::load(dir.join("full.toml")).unwrap().build_model().unwrap();
+    let f = full.linear.dense_modes().unwrap().frequencies_hz();
+    let study = |keys: &str| {
+        let text =
+            format!("[model]\nmesh = \"bar.inp\"\n[reduction]\nmethod = \"free\"\nretain = [\"TIP\"]\n{keys}\n{REST}");
+        std::fs::write(dir.join("s.toml"), text).unwrap();
+        Study::load(dir.join("s.toml")).and_then(|s| s.build_model())
+    };
+    // Halfway between the 5th free mode (or the last copy of it: the square bar's bending modes
+    // are double) and the next: every mode up to there, 12 retained DOFs.
+    let mut last = 4;
+    while f[last + 1] - f[last] < 1e-6 * f[last + 1] {
+        last += 1;
+    }
+    let (red, _, _) = study(&format!("modes_up_to_hz = {}", 0.5 * (f[last] + f[last + 1]))).unwrap();
+    assert_eq!(red.linear.n_dofs(), 12 + last + 1, "{:?} Hz", &f[..last + 2]);
+    let g = lowest_hz(&red.linear, last + 1);
+    for (a, b) in f.iter().zip(&g) {
+        assert!((a - b).abs() < 1e-8 * a, "full {:?} Hz, reduced {g:?} Hz", &f[..=last]);
+    }
+    let msg = |keys: &str| study(keys).unwrap_err().to_string();
+    let e = msg("modes = 4\nmodes_up_to_hz = 1000.0");
+    assert!(e.contains("[reduction]: give either `modes` (a number of modes) or `modes_up_to_hz`"), "{e}");
+    let e = msg("modes_up_to_hz = -5.0");
+    assert!(e.contains("[reduction]: modes_up_to_hz must be > 0 Hz, got -5"), "{e}");
+    let e = msg("");
+    assert!(e.contains("[reduction]: needs `modes` (a number of modes) or `modes_up_to_hz`"), "{e}");
+    let e = msg(&format!("modes_up_to_hz = {}", 0.5 * f[0]));
+    assert!(e.contains("modes_up_to_hz") && e.contains("has no mode up to"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn an_unknown_retained_set_is_named() {
     let dir = scratch_dir("mesh-retain");

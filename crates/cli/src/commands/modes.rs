@@ -78,6 +78,11 @@ pub struct Args {
     /// Find the modes nearest this frequency (Hz) instead of the lowest ones.
     #[arg(long)]
     pub shift: Option<f64>,
+    /// Every mode with F1 <= f <= F2 (Hz, F1:F2, e.g. 2000:3000), however many there are: the
+    /// inertia of K - sigma M at both ends counts them, so none is missed. 0:F2 gives every mode
+    /// up to F2, rigid-body modes included. Not with --count or --shift.
+    #[arg(long, value_name = "F1:F2", conflicts_with_all = ["count", "shift"], allow_hyphen_values = true)]
+    pub band: Option<String>,
     /// Directory for modes.csv and the mode shapes.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -184,6 +189,30 @@ pub fn shift_from_hz(hz: Option<f64>) -> Option<f64> {
     hz.map(|f| (2.0 * std::f64::consts::PI * f).powi(2) * f.signum())
 }
 
+/// ω² in rad²/s² of a frequency in Hz.
+fn lambda_from_hz(f: f64) -> f64 {
+    (std::f64::consts::TAU * f).powi(2)
+}
+
+/// `--band F1:F2` (or `F1,F2`) in Hz: two finite frequencies, `0 <= F1 <= F2`.
+pub fn parse_band(text: &str) -> anyhow::Result<(f64, f64)> {
+    let usage = "expected two frequencies in Hz, F1:F2 with 0 <= F1 <= F2 (e.g. --band 2000:3000)";
+    let Some((a, b)) = text.split_once(':').or_else(|| text.split_once(',')) else {
+        bail!("--band {text}: {usage}");
+    };
+    let parse = |x: &str| x.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+    let (Some(f1), Some(f2)) = (parse(a), parse(b)) else {
+        bail!("--band {text}: the ends must be finite numbers; {usage}");
+    };
+    if f1 < 0.0 {
+        bail!("--band {text}: the lower end is negative; {usage}");
+    }
+    if f2 < f1 {
+        bail!("--band {text}: the ends are reversed; {usage}");
+    }
+    Ok((f1, f2))
+}
+
 /// Effective masses `(φᵀ M r_d)²` of a mass-normalised mode along the rigid translations
 /// `r_d` (1 on every DOF of direction `d`), d = x, y, z; `None` without nodal labels.
 pub fn effective_masses(model: &LinearModel, sol: &EigenSolution) -> Option<Vec<[f64; 3]>> {
@@ -218,18 +247,44 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let model = &loaded.model;
     let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
     let (k, m) = (&*k, &*m);
-    let opts = EigenOptions { count: args.count, shift: shift_from_hz(args.shift), ..Default::default() };
+    let band = args.band.as_deref().map(parse_band).transpose()?;
     let start = Instant::now();
-    eprintln!("solving for {} modes ...", args.count);
-    let sol = eigen::solve(k, m, &opts)?;
-    eprintln!(
-        "modes: {:.2} s ({} solves, {} restarts, shift {:.4e} rad^2/s^2, {} eigenvalues below it)",
-        start.elapsed().as_secs_f64(),
-        sol.solves,
-        sol.restarts,
-        sol.shift,
-        sol.below_shift
-    );
+    let sol = match band {
+        Some((f1, f2)) => {
+            eprintln!("solving for every mode between {f1} and {f2} Hz ...");
+            let sol = eigen::solve_band(k, m, lambda_from_hz(f1), lambda_from_hz(f2), &EigenOptions::default())
+                .map_err(|e| match e {
+                    eigen::EigenError::Band(what) => anyhow::anyhow!("--band {f1}:{f2}: {what}"),
+                    e => e.into(),
+                })?;
+            eprintln!(
+                "modes: {:.2} s ({} solves, {} restarts, {} eigenvalues below {f1} Hz and {} in the band, counted by the inertia of K - sigma M at its ends)",
+                start.elapsed().as_secs_f64(),
+                sol.solves,
+                sol.restarts,
+                sol.below_shift,
+                sol.modes.omega.len()
+            );
+            if sol.modes.omega.is_empty() {
+                eprintln!("no mode between {f1} and {f2} Hz: modes.csv holds its header only");
+            }
+            sol
+        }
+        None => {
+            let opts = EigenOptions { count: args.count, shift: shift_from_hz(args.shift), ..Default::default() };
+            eprintln!("solving for {} modes ...", args.count);
+            let sol = eigen::solve(k, m, &opts)?;
+            eprintln!(
+                "modes: {:.2} s ({} solves, {} restarts, shift {:.4e} rad^2/s^2, {} eigenvalues below it)",
+                start.elapsed().as_secs_f64(),
+                sol.solves,
+                sol.restarts,
+                sol.shift,
+                sol.below_shift
+            );
+            sol
+        }
+    };
     let eff = effective_masses(model, &sol);
     let freqs = sol.modes.frequencies_hz();
     // The solver refuses non-finite modes; a table of NaN is never written with success.

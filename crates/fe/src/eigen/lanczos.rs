@@ -307,7 +307,7 @@ fn block_krylov(
 ) -> Result<Option<EigenSolution>, EigenError> {
     let n = k.nrows();
     let nev = opts.count;
-    let b = nev.div_ceil(3).clamp(1, 16).min(n);
+    let b = opts.block.unwrap_or(nev.div_ceil(3).clamp(1, 16)).clamp(1, n);
     // Basis size before a restart: the wanted vectors and twice as many again (eight blocks
     // at least) for the unwanted part of the spectrum that the restarts filter out; a block
     // recurrence needs several blocks between restarts to filter (measured on a 25,830-DOF

@@ -7,12 +7,14 @@
 //! The shift σ lies below the lowest eigenvalue by default (a small negative value), so
 //! free-free structures, whose rigid-body modes sit at ω = 0, are solved as they are. Every
 //! returned mode's residual `‖Kφ − ω²Mφ‖ / ‖Kφ‖` is computed and returned.
+mod band;
 mod factor;
 mod lanczos;
 pub mod ordering;
 mod product;
 mod update;
 
+pub use band::{count_in_band, solve_band, solve_band_split, MODES_PER_SHIFT};
 pub use factor::{ShiftInvert, ShiftedFactor};
 pub use product::{symmetric_product, symmetric_times};
 pub use update::LowRankUpdate;
@@ -37,6 +39,10 @@ pub enum EigenError {
     MassIndefinite { what: String },
     #[error("mode {mode} has residual ||K phi - w^2 M phi|| / ||K phi|| = {residual:.2e} above {tolerance:.1e}: the factorisation is inaccurate (check the matrices for near-singular blocks)")]
     Inaccurate { mode: usize, residual: f64, tolerance: f64 },
+    #[error("band: {0}")]
+    Band(String),
+    #[error("band [{lower_hz} Hz, {upper_hz} Hz]: the inertia of K - sigma M at its ends counts {expected} eigenvalues in it and the Lanczos iteration found {found} of them (repeated eigenvalues beyond the block size?); split the band")]
+    BandIncomplete { lower_hz: f64, upper_hz: f64, expected: usize, found: usize },
     #[error("the sparse factor of K - sigma M would take {needed_gb:.1} GB ({entries} entries, estimated by the symbolic analysis before factorising) and this machine has {available_gb:.1} GB available: use a coarser mesh or a machine with more memory")]
     FactorTooLarge { entries: usize, needed_gb: f64, available_gb: f64 },
 }
@@ -62,6 +68,11 @@ pub struct EigenOptions {
     pub subspace: Option<usize>,
     /// Largest accepted final residual `‖Kφ − ω²Mφ‖ / ‖Kφ‖`.
     pub residual_limit: f64,
+    /// Vectors per block of the block Lanczos (`None`: `count / 3` within 1..=16). A block
+    /// needs as many vectors as the largest multiplicity of the wanted eigenvalues to find
+    /// every copy of a repeated one (in exact arithmetic a Krylov space of `b` start vectors
+    /// holds at most `b` directions of an eigenspace).
+    pub block: Option<usize>,
 }
 
 impl Default for EigenOptions {
@@ -73,6 +84,7 @@ impl Default for EigenOptions {
             max_restarts: 200,
             subspace: None,
             residual_limit: 1e-6,
+            block: None,
         }
     }
 }
@@ -85,9 +97,10 @@ pub struct EigenSolution {
     /// `‖Kφ − ω²Mφ‖ / ‖Kφ‖` of each mode (for rigid-body modes, whose `Kφ` vanishes, the
     /// denominator is `|σ| ‖Mφ‖` instead).
     pub residuals: Vec<f64>,
-    /// The shift used, rad²/s².
+    /// The shift used, rad²/s² (for a band, that of its lowest part).
     pub shift: f64,
-    /// Number of eigenvalues below the shift (inertia of `K − σM`).
+    /// Number of eigenvalues below the shift (inertia of `K − σM`); for a band
+    /// ([`solve_band`]), below its lower end.
     pub below_shift: usize,
     /// Linear solves with the factor and Lanczos restarts used.
     pub solves: usize,
@@ -127,7 +140,7 @@ pub fn modes_with_factor(
 /// not finite (mass-normalising a direction of negative mass divides by the square root of a
 /// negative number: the solver's NaN residual passed its `>` test and the mode came out as
 /// f = 0). The Lanczos iteration itself assumes the M inner product.
-fn check_mass(m: &SparseColMat<usize, f64>, solution: Option<&EigenSolution>) -> Result<(), EigenError> {
+pub(crate) fn check_mass(m: &SparseColMat<usize, f64>, solution: Option<&EigenSolution>) -> Result<(), EigenError> {
     let Some(sol) = solution else {
         if m.nrows() == m.ncols() {
             if let Some((i, d)) = diagonal(m).into_iter().enumerate().find(|(_, d)| d.is_nan() || *d < 0.0) {

@@ -205,6 +205,26 @@ fn finish(
     })
 }
 
+/// The number of modes with ω² ≤ `upper` (rad²/s²) that a reduction would keep, from the
+/// inertia of `K − σM` (Sylvester's law, no mode computed): of `(K_ee, M_ee)` with the
+/// retained DOFs clamped for Craig-Bampton (`fixed_interface`), of the whole `(K, M)` for the
+/// free-mode bases.
+pub fn modes_up_to(
+    model: &LinearModel,
+    retained: &[usize],
+    fixed_interface: bool,
+    upper: f64,
+) -> Result<usize, ReductionError> {
+    let (k, m) = (to_sparse(&model.stiffness), to_sparse(&model.mass));
+    if fixed_interface {
+        let part = partition(model, retained)?;
+        let (kee, mee) = (interior_block(&k, &part), interior_block(&m, &part));
+        Ok(eigen::count_in_band(&kee, &mee, 0.0, upper)?)
+    } else {
+        Ok(eigen::count_in_band(&k, &m, 0.0, upper)?)
+    }
+}
+
 /// Craig-Bampton: constraint modes + the `opts.modes` lowest fixed-interface modes (modes of
 /// `(K_ee, M_ee)`, retained DOFs clamped). One LDLᵀ of `K_ee` serves both: the eigensolver
 /// works at shift 0, which `K_ee` allows whenever the constraint modes exist.

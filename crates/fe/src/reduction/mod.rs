@@ -13,7 +13,7 @@ use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix, ModelError, 
 
 use crate::eigen::{EigenError, EigenOptions};
 
-pub use basis::{craig_bampton, enriched, free_modes};
+pub use basis::{craig_bampton, enriched, free_modes, modes_up_to};
 
 /// Why a reduction cannot be built.
 #[derive(Debug, thiserror::Error)]

@@ -879,8 +879,27 @@ fn reduce(
             }
         }
     }
-    let options = ReductionOptions { retained, modes: spec.modes, eigen: EigenOptions::default() };
     let reduction_error = |source| StudyErrorKind::Reduction { context: "[reduction]".into(), source };
+    let modes = match spec.up_to_hz {
+        None => spec.modes,
+        Some(hz) => {
+            // Counted by the inertia of K − σM (fixed-interface for Craig-Bampton): every mode
+            // up to the frequency, none guessed.
+            let upper = (std::f64::consts::TAU * hz).powi(2);
+            let cb = matches!(spec.method, ReductionMethod::CraigBampton);
+            let n = reduction::modes_up_to(full, &retained, cb, upper).map_err(|source| StudyErrorKind::Reduction {
+                context: format!("[reduction] modes_up_to_hz = {hz}"),
+                source,
+            })?;
+            if n == 0 && !cb {
+                return Err(StudyErrorKind::Invalid(format!(
+                    "[reduction] modes_up_to_hz = {hz}: the model has no mode up to {hz} Hz, and the free-mode methods need at least one: raise it"
+                )));
+            }
+            n
+        }
+    };
+    let options = ReductionOptions { retained, modes, eigen: EigenOptions::default() };
     match spec.method {
         ReductionMethod::CraigBampton => reduction::craig_bampton(full, &options),
         ReductionMethod::FreeModes => reduction::free_modes(full, &options),

@@ -131,8 +131,11 @@ pub struct ReductionSpec {
     pub method: ReductionMethod,
     /// Retained DOFs: node sets of the mesh (all DOFs of their nodes) or DOF names.
     pub retain: Vec<String>,
-    /// Number of modes in the basis.
+    /// Number of modes in the basis (0 when `up_to_hz` gives them).
     pub modes: usize,
+    /// Every mode up to this frequency (Hz) instead of a number: counted when the model is
+    /// built, by the inertia of `K − σM` (`modes_up_to_hz`).
+    pub up_to_hz: Option<f64>,
     pub at: Location,
 }
 

@@ -93,7 +93,8 @@ pub(crate) struct RawMaterial {
 pub(crate) struct RawReduction {
     pub method: S<String>,
     pub retain: S<Vec<String>>,
-    pub modes: S<i64>,
+    pub modes: Option<S<i64>>,
+    pub modes_up_to_hz: Option<S<f64>>,
     pub release_modes: Option<S<i64>>,
 }
 

@@ -631,7 +631,22 @@ fn model(
 fn reduction(src: &Source, r: &S<raw::RawReduction>) -> Result<ReductionSpec, StudyError> {
     const CTX: &str = "[reduction]";
     let raw = r.get_ref();
-    let modes = count(src, &raw.modes, CTX, "modes", 0)?;
+    let (modes, up_to_hz) = match (&raw.modes, &raw.modes_up_to_hz) {
+        (Some(n), None) => (count(src, n, CTX, "modes", 0)?, None),
+        (None, Some(f)) => (0, Some(positive(src, f, CTX, "modes_up_to_hz", " Hz")?)),
+        (Some(_), Some(f)) => {
+            return Err(src.invalid(
+                &f.span(),
+                format!("{CTX}: give either `modes` (a number of modes) or `modes_up_to_hz` (every mode up to a frequency), not both"),
+            ))
+        }
+        (None, None) => {
+            return Err(src.invalid(
+                &r.span(),
+                format!("{CTX}: needs `modes` (a number of modes) or `modes_up_to_hz` (every mode up to a frequency in Hz)"),
+            ))
+        }
+    };
     let method = match raw.method.get_ref().as_str() {
         "cb" => ReductionMethod::CraigBampton,
         "free" => ReductionMethod::FreeModes,
@@ -653,13 +668,23 @@ fn reduction(src: &Source, r: &S<raw::RawReduction>) -> Result<ReductionSpec, St
     if let (Some(n), false) = (&raw.release_modes, matches!(method, ReductionMethod::Enriched { .. })) {
         return Err(src.invalid(&n.span(), format!("{CTX}: release_modes goes with method = \"enriched\"")));
     }
-    if matches!(method, ReductionMethod::FreeModes | ReductionMethod::Enriched { .. }) && modes == 0 {
-        return Err(src.invalid(&raw.modes.span(), format!("{CTX}: the free-mode methods need modes >= 1")));
+    if let (true, Some(n)) =
+        (matches!(method, ReductionMethod::FreeModes | ReductionMethod::Enriched { .. }), &raw.modes)
+    {
+        if modes == 0 {
+            return Err(src.invalid(&n.span(), format!("{CTX}: the free-mode methods need modes >= 1")));
+        }
     }
     if raw.retain.get_ref().is_empty() {
         return Err(src.invalid(&raw.retain.span(), format!("{CTX}: retain must name at least one node set or DOF")));
     }
-    Ok(ReductionSpec { method, retain: raw.retain.get_ref().clone(), modes, at: src.location(&raw.retain.span()) })
+    Ok(ReductionSpec {
+        method,
+        retain: raw.retain.get_ref().clone(),
+        modes,
+        up_to_hz,
+        at: src.location(&raw.retain.span()),
+    })
 }
 
 fn dof_names(src: &Source, dofs: &S<Vec<String>>) -> Result<Vec<String>, StudyError> {
