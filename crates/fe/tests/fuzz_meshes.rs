@@ -34,10 +34,19 @@ const DECK: &str = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n5, 2,
 *ELEMENT, TYPE=MASS, ELSET=M\n10, 5\n*MASS, ELSET=M\n2.5\n*ELEMENT, TYPE=SPRINGA, ELSET=S\n11, 2, 5\n\
 *SPRING, ELSET=S\n\n1e6\n*BOUNDARY\nFIX, 1, 3\n";
 
+/// A reference node whose rotations a rotation node carries (`*RIGID BODY ... ROT NODE`), with
+/// a spring and a boundary on the rotation node's DOFs.
+const ROT_NODE_DECK: &str = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n5, 0, 0, 2\n6, 0, 0, 2\n\
+*ELEMENT, TYPE=C3D4, ELSET=SOLID\n1, 1, 2, 3, 4\n*NSET, NSET=TOP\n4\n\
+*MATERIAL, NAME=STEEL\n*ELASTIC\n210e9, 0.3\n*DENSITY\n7800\n*SOLID SECTION, ELSET=SOLID, MATERIAL=STEEL\n\
+*RIGID BODY, NSET=TOP, REF NODE=5, ROT NODE=6\n*ELEMENT, TYPE=SPRING1, ELSET=R\n11, 6\n\
+*SPRING, ELSET=R\n2, 2\n1e4\n*BOUNDARY\n6, 3, 3\n1, 1, 3\n";
+
 #[test]
 fn inp_decks() {
     let seeds = [
         DECK.as_bytes().to_vec(),
+        ROT_NODE_DECK.as_bytes().to_vec(),
         std::fs::read(data("deck_mesh.inp")).unwrap(),
         std::fs::read(data("deck_main.inp")).unwrap(),
     ];
@@ -82,4 +91,12 @@ fn found_by_fuzzing() {
         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n1 0 0 0\n1 0 0 0 1 -9223372036854775808\n$EndEntities\n";
     let e = gmsh::parse(text.as_bytes(), Path::new("tag.msh")).unwrap_err().to_string();
     assert!(e.starts_with("tag.msh:6: a physical tag -9223372036854775808 is not a 32-bit integer"), "{e}");
+}
+
+/// The fuzz seed with a rotation node reads as a deck (so that its mutations exercise that
+/// path, not only the error of a broken seed).
+#[test]
+fn the_rotation_node_seed_is_a_valid_deck() {
+    let mesh = inp::parse(ROT_NODE_DECK, &data("fuzz.inp").display().to_string()).unwrap();
+    assert!(mesh.nodes.iter().all(|n| n.id != 6), "the rotation node is folded into its reference node");
 }
