@@ -38,13 +38,11 @@ fn harmonic_of(c: usize) -> usize {
     c.div_ceil(2)
 }
 
-/// The coefficients of harmonic k: the constant, or its cosine and sine.
-fn coefficients(k: usize) -> Vec<usize> {
-    if k == 0 {
-        vec![0]
-    } else {
-        vec![cos_index(k), sin_index(k)]
-    }
+/// The coefficients of harmonic k: the constant, or its cosine and sine (no allocation: this
+/// runs for every entry of the reduced matrix).
+fn coefficients(k: usize) -> impl Iterator<Item = usize> {
+    let (first, second) = if k == 0 { (0, None) } else { (cos_index(k), Some(sin_index(k))) };
+    std::iter::once(first).chain(second)
 }
 
 /// The factored Jacobian `I + H B` of one iterate.
