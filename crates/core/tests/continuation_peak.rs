@@ -3,7 +3,7 @@
 //! oscillator, and the peak of a hardening Duffing oscillator, which lies next to a fold.
 use faer::MatMut;
 use stickslip_core::continuation::{
-    continue_branch, maximise_along, Options, Point, Problem, ProblemError, Silent, TerminationReason,
+    continue_branch, maximise_along, Bracket, Options, Point, Problem, ProblemError, Silent, TerminationReason,
 };
 
 /// One-harmonic balance of `m ẍ + c ẋ + k x + k3 x³ = F cos Ωt`, `x = a cos Ωt + b sin Ωt`,
@@ -98,4 +98,47 @@ fn the_peak_of_a_hardening_duffing_oscillator_next_to_its_fold_is_located() {
     // bracket's hyperplanes cross the branch there transversally.
     assert!((found.value - a2.sqrt()).abs() < 1e-10 * a2.sqrt(), "{} vs {}", found.value, a2.sqrt());
     assert!((found.lambda - w_peak).abs() < 1e-6 * w_peak, "{} vs {w_peak}", found.lambda);
+}
+
+#[test]
+fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds_alone() {
+    // Two outputs of one resonance: the displacement amplitude A, and the velocity Ω A, which
+    // peaks a little higher, at ω_n exactly against ω_n √(1 − 2ζ²); then the power A², which
+    // peaks where A does.
+    let (m, wn, zeta, f) = (2.0, 2.0 * std::f64::consts::PI * 100.0, 0.02, 10.0);
+    let mut p = Oscillator { m, c: 2.0 * zeta * m * wn, k: m * wn * wn, k3: 0.0, f };
+    let guess = [f / (p.k - m * 0.25 * wn * wn), 0.0];
+    let branch = continue_branch(&mut p, &guess, 0.5 * wn, 1.5 * wn, &Options::default(), &mut Silent).unwrap();
+    let pts = &branch.points;
+    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    let bracket = [&pts[i - 1], &pts[i], &pts[i + 1]];
+    let velocity = |_: &mut Oscillator, x: &[f64], w: f64| Ok(w * amplitude(x));
+    let power = |_: &mut Oscillator, x: &[f64], _: f64| Ok(amplitude(x).powi(2));
+    let alone = [
+        maximise_along(&mut p, bracket, 1e-9, |_, x, _| Ok(amplitude(x))).unwrap(),
+        maximise_along(&mut p, bracket, 1e-9, velocity).unwrap(),
+        maximise_along(&mut p, bracket, 1e-9, power).unwrap(),
+    ];
+    let mut shared = Bracket::new(&mut p, bracket).unwrap();
+    let found = [
+        shared.maximise(&mut p, 1e-9, |_, x, _| Ok(amplitude(x))).unwrap(),
+        shared.maximise(&mut p, 1e-9, velocity).unwrap(),
+        shared.maximise(&mut p, 1e-9, power).unwrap(),
+    ];
+    // The same searches on the same points, solved to round-off from other guesses, so Brent's
+    // steps may differ by round-off: λ equal to the search's tolerance (1e-9 of the bracket's
+    // chord, itself ~10 % of λ: 1e-10, asserted 1e-9), the value to round-off (the peak is
+    // flat: 1e-12 asserted).
+    for (s, a) in found.iter().zip(&alone) {
+        assert!((s.lambda / a.lambda - 1.0).abs() < 1e-9, "{} vs {}", s.lambda, a.lambda);
+        assert!((s.value / a.value - 1.0).abs() < 1e-12, "{} vs {}", s.value, a.value);
+    }
+    assert!((found[1].lambda - wn).abs() < 1e-9 * wn, "{} vs {wn}", found[1].lambda);
+    assert!((found[0].lambda - found[1].lambda).abs() > 1e-4 * wn);
+    // Each later search solved only the lattice points outside the earlier windows and its own
+    // Brent steps: the power's window is the amplitude's, so its search solved only Brent's
+    // steps (to 1e-9, at most ~20), against a whole scan alone.
+    assert_eq!(found[0].solves, alone[0].solves);
+    assert!(found[1].solves < alone[1].solves, "{} solves shared, {} alone", found[1].solves, alone[1].solves);
+    assert!(found[2].solves <= 20 && alone[2].solves > 60, "{} shared, {} alone", found[2].solves, alone[2].solves);
 }

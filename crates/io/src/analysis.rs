@@ -4,10 +4,11 @@
 //! [`output::PointRecord`](crate::output::PointRecord); and the [`ReportData`] of a whole run
 //! ([`report_data`]).
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use stickslip_core::continuation::{
-    maximise_along, Branch, Observer, Options, Predictor, ProblemError, Rejection, Silent, TerminationReason,
+    Bracket, Branch, Observer, Options, Predictor, ProblemError, Rejection, Silent, TerminationReason,
 };
 use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::{
@@ -210,8 +211,10 @@ const PEAK_TOLERANCE: f64 = 1e-9;
 const BIFURCATION_TOLERANCE: f64 = 1e-10;
 
 /// Per output, the resonance peak of |X₁|/F located along the branch between the neighbours of
-/// its largest sampled point ([`maximise_along`]), so that the peak table does not depend on
-/// the point density. At an end of the band, or if the location fails, the sampled point.
+/// its largest sampled point ([`Bracket::maximise`]), so that the peak table does not depend on
+/// the point density. Outputs that peak at the same sampled point share the points solved
+/// around it (a structure's outputs mostly resonate together). At an end of the band, or if
+/// the location fails, the sampled point.
 fn locate_peaks(
     hbm: &mut CondensedHbm<'_>,
     branch: &Branch,
@@ -220,6 +223,8 @@ fn locate_peaks(
     records: &[PointRecord],
 ) -> Vec<Peak> {
     let mut peaks = Vec::with_capacity(selectors.len());
+    // The bracket around each sampled maximum, made once (`None`: it could not be).
+    let mut brackets: BTreeMap<usize, Option<Bracket>> = BTreeMap::new();
     for (o, selector) in selectors.iter().enumerate() {
         let Some(i) = (0..records.len())
             .filter(|&i| records[i].outputs[o].disp_frf.is_finite())
@@ -240,13 +245,18 @@ fn locate_peaks(
             continue;
         }
         let one = std::slice::from_ref(selector);
-        let bracket = [&branch.points[i - 1], &branch.points[i], &branch.points[i + 1]];
-        let found = maximise_along(&mut FrequencySweep { hbm, level }, bracket, PEAK_TOLERANCE, |p, x, omega| {
-            let r = evaluate_point(p.hbm, x, omega, level, one).map_err(|e| ProblemError::new(e.to_string()))?;
-            Ok(r.outputs[0].harmonic(1).0)
+        let mut problem = FrequencySweep { hbm, level };
+        let bracket = brackets.entry(i).or_insert_with(|| {
+            Bracket::new(&mut problem, [&branch.points[i - 1], &branch.points[i], &branch.points[i + 1]]).ok()
+        });
+        let found = bracket.as_mut().map(|bracket| {
+            bracket.maximise(&mut problem, PEAK_TOLERANCE, |p, x, omega| {
+                let r = evaluate_point(p.hbm, x, omega, level, one).map_err(|e| ProblemError::new(e.to_string()))?;
+                Ok(r.outputs[0].harmonic(1).0)
+            })
         });
         peaks.push(match found {
-            Ok(e) if e.value / level >= sampled.disp_frf => Peak {
+            Some(Ok(e)) if e.value / level >= sampled.disp_frf => Peak {
                 frequency_hz: e.lambda / TWO_PI,
                 disp_frf: e.value / level,
                 accel_frf: e.lambda * e.lambda * e.value / level,

@@ -15,6 +15,8 @@
 //! around the best by Brent's method (golden section with parabolic steps, Brent 1973, ch. 5). It is written here rather than taken from `argmin`,
 //! whose solver framework is far more than one bounded scalar search needs.
 
+use std::collections::BTreeMap;
+
 use super::linear::Workspace;
 use super::{Point, Problem, ProblemError};
 
@@ -25,7 +27,8 @@ pub struct Extremum {
     pub lambda: f64,
     /// The quantity there.
     pub value: f64,
-    /// Points solved on the branch to locate it.
+    /// Points solved on the branch to locate it (not counting those shared with an earlier
+    /// search of the same [`Bracket`]).
     pub solves: usize,
 }
 
@@ -46,109 +49,158 @@ const WINDOW: f64 = 0.15;
 /// found is converged to round-off (Newton until the scaled update stops decreasing).
 pub fn maximise_along<P: Problem>(
     problem: &mut P,
-    [before, middle, after]: [&Point; 3],
+    bracket: [&Point; 3],
     tolerance: f64,
-    mut quantity: impl FnMut(&mut P, &[f64], f64) -> Result<f64, ProblemError>,
+    quantity: impl FnMut(&mut P, &[f64], f64) -> Result<f64, ProblemError>,
 ) -> Result<Extremum, ProblemError> {
-    let n = problem.dimension();
-    // Scaled variables z = [x/s_x, λ/s_λ]: the chord has comparable x and λ parts.
-    let x_scale = [before, middle, after]
-        .iter()
-        .map(|p| p.x.iter().map(|v| v * v).sum::<f64>().sqrt())
-        .fold(f64::MIN_POSITIVE, f64::max);
-    let lambda_scale = (after.lambda - before.lambda).abs().max(1e-12 * middle.lambda.abs()).max(f64::MIN_POSITIVE);
-    let scaled = |p: &Point| -> Vec<f64> {
-        p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
-    };
-    let (z0, zm, z1) = (scaled(before), scaled(middle), scaled(after));
-    let chord: Vec<f64> = z1.iter().zip(&z0).map(|(b, a)| b - a).collect();
-    let chord2: f64 = chord.iter().map(|c| c * c).sum();
-    let sm = chord.iter().zip(zm.iter().zip(&z0)).map(|(c, (m, a))| c * (m - a)).sum::<f64>() / chord2;
-    if !(sm > 0.0 && sm < 1.0) {
-        return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
+    Bracket::new(problem, bracket)?.maximise(problem, tolerance, quantity)
+}
+
+/// The branch between three of its points, where several quantities may be maximised in turn
+/// ([`Bracket::maximise`]): the outputs of a structure that peak between the same two points
+/// share the points solved there. The scan of each maximum lies on one lattice of `s` (spacing
+/// `2 WINDOW / SCAN`), so the scans of quantities whose vertices are near each other solve
+/// mostly the same points, once.
+pub struct Bracket {
+    z0: Vec<f64>,
+    zm: Vec<f64>,
+    z1: Vec<f64>,
+    /// `s` of the middle point.
+    sm: f64,
+    path: ChordPath,
+    /// Points solved so far, by `s` (bit pattern: lattice points are computed identically):
+    /// `None` where the branch could not be solved.
+    solved: BTreeMap<u64, Option<Vec<f64>>>,
+    /// The last point solved, the guess for a near one.
+    last: Option<(f64, Vec<f64>)>,
+    /// Points solved on the branch so far.
+    pub solves: usize,
+}
+
+impl Bracket {
+    pub fn new<P: Problem>(problem: &mut P, [before, middle, after]: [&Point; 3]) -> Result<Self, ProblemError> {
+        // Scaled variables z = [x/s_x, λ/s_λ]: the chord has comparable x and λ parts.
+        let x_scale = [before, middle, after]
+            .iter()
+            .map(|p| p.x.iter().map(|v| v * v).sum::<f64>().sqrt())
+            .fold(f64::MIN_POSITIVE, f64::max);
+        let lambda_scale = (after.lambda - before.lambda).abs().max(1e-12 * middle.lambda.abs()).max(f64::MIN_POSITIVE);
+        let scaled = |p: &Point| -> Vec<f64> {
+            p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
+        };
+        let (z0, zm, z1) = (scaled(before), scaled(middle), scaled(after));
+        let chord: Vec<f64> = z1.iter().zip(&z0).map(|(b, a)| b - a).collect();
+        let chord2: f64 = chord.iter().map(|c| c * c).sum();
+        let sm = chord.iter().zip(zm.iter().zip(&z0)).map(|(c, (m, a))| c * (m - a)).sum::<f64>() / chord2;
+        if !(sm > 0.0 && sm < 1.0) {
+            return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
+        }
+        let path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
+        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), last: None, solves: 0 })
     }
 
-    let mut path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
-    let mut z = vec![0.0; n + 1];
-    let mut solves = 0;
-    // The point at s: from the last point solved if it is near (the scan's neighbours, one or
-    // two Newton iterations), else from the parabola through the three points.
-    let mut last: Option<(f64, Vec<f64>)> = None;
-    let mut solve = |problem: &mut P, s: f64, z: &mut Vec<f64>| -> Result<bool, ProblemError> {
-        solves += 1;
-        match &last {
-            Some((s_last, z_last)) if (s - s_last).abs() <= 0.02 => {
-                for i in 0..=n {
-                    z[i] = z_last[i] + (s - s_last) * path.chord[i];
+    /// The point at `s` (scaled), solved once: from the last point solved if it is near (the
+    /// scan's neighbours, one or two Newton iterations), else from the parabola through the
+    /// three points. `None` if it cannot be solved there.
+    fn point<P: Problem>(&mut self, problem: &mut P, s: f64) -> Result<Option<&[f64]>, ProblemError> {
+        let key = s.to_bits();
+        if !self.solved.contains_key(&key) {
+            let n = self.path.n;
+            let mut z = vec![0.0; n + 1];
+            match &self.last {
+                Some((s_last, z_last)) if (s - s_last).abs() <= 0.02 => {
+                    for i in 0..=n {
+                        z[i] = z_last[i] + (s - s_last) * self.path.chord[i];
+                    }
+                }
+                _ => {
+                    let sm = self.sm;
+                    let (l0, lm, l1) =
+                        ((s - sm) * (s - 1.0) / sm, s * (s - 1.0) / (sm * (sm - 1.0)), s * (s - sm) / (1.0 - sm));
+                    for i in 0..=n {
+                        z[i] = l0 * self.z0[i] + lm * self.zm[i] + l1 * self.z1[i];
+                    }
                 }
             }
-            _ => {
-                let (l0, lm, l1) =
-                    ((s - sm) * (s - 1.0) / sm, s * (s - 1.0) / (sm * (sm - 1.0)), s * (s - sm) / (1.0 - sm));
-                for i in 0..=n {
-                    z[i] = l0 * z0[i] + lm * zm[i] + l1 * z1[i];
-                }
+            self.solves += 1;
+            let solved = self.path.solve(problem, s, &mut z)?;
+            if solved {
+                self.last = Some((s, z.clone()));
             }
+            self.solved.insert(key, solved.then_some(z));
         }
-        let solved = path.solve(problem, s, z)?;
-        if solved {
-            last = Some((s, z.clone()));
-        }
-        Ok(solved)
-    };
-    // The quantity at s; the best point so far is kept.
-    let mut best = (f64::NEG_INFINITY, zm.clone());
-    let mut value_at = |problem: &mut P, s: f64| -> Result<f64, ProblemError> {
-        if !solve(problem, s, &mut z)? {
-            // A point that cannot be solved is not the maximum.
-            return Ok(f64::NEG_INFINITY);
-        }
-        let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
-        let value = quantity(problem, &x, z[n] * lambda_scale)?;
-        if value > best.0 {
-            best = (value, z.clone());
-        }
-        Ok(value)
-    };
+        Ok(self.solved[&key].as_deref())
+    }
 
-    // A friction peak is a chain of smooth arcs joined at corners: the slip instants move in
-    // steps of one time sample as the phase turns through the resonance, every few hundredths
-    // of a hertz for 300 samples. Each arc has its own local maximum, within ~1e-5 of the
-    // others near the top. The three sampled points place the envelope's vertex (a parabola
-    // through them); a dense scan around it finds the highest arc, Brent's method then its
-    // maximum.
-    let (f0, fm, f1) = (value_at(problem, 0.0)?, value_at(problem, sm)?, value_at(problem, 1.0)?);
-    let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
-    let denominator = sm * d0 - (sm - 1.0) * d1;
-    let vertex = if denominator != 0.0 && denominator.is_finite() {
-        (sm - 0.5 * (sm * d0 * sm - (sm - 1.0) * d1 * (sm - 1.0)) / denominator).clamp(0.0, 1.0)
-    } else {
-        sm
-    };
-    let (lo, hi) = ((vertex - WINDOW).max(0.0), (vertex + WINDOW).min(1.0));
-    let mut samples: Vec<(f64, f64)> = vec![(sm, fm)];
-    for k in 0..=SCAN {
-        let s = lo + (hi - lo) * k as f64 / SCAN as f64;
-        if s > 0.0 && s < 1.0 {
-            samples.push((s, value_at(problem, s)?));
+    /// The maximum of `quantity(problem, x, λ)` between the bracket's ends, to `tolerance` on
+    /// `s`. `solves` of the result counts the points solved for it: not those an earlier search
+    /// of this bracket solved already.
+    pub fn maximise<P: Problem>(
+        &mut self,
+        problem: &mut P,
+        tolerance: f64,
+        mut quantity: impl FnMut(&mut P, &[f64], f64) -> Result<f64, ProblemError>,
+    ) -> Result<Extremum, ProblemError> {
+        let n = self.path.n;
+        let (x_scale, lambda_scale, sm) = (self.path.x_scale, self.path.lambda_scale, self.sm);
+        let solved_before = self.solves;
+        // The quantity at s; the best point so far is kept.
+        let mut best = (f64::NEG_INFINITY, self.zm.clone());
+        let mut value_at = |bracket: &mut Bracket, problem: &mut P, s: f64| -> Result<f64, ProblemError> {
+            let Some(z) = bracket.point(problem, s)? else {
+                // A point that cannot be solved is not the maximum.
+                return Ok(f64::NEG_INFINITY);
+            };
+            let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
+            let value = quantity(problem, &x, z[n] * lambda_scale)?;
+            if value > best.0 {
+                best = (value, z.to_vec());
+            }
+            Ok(value)
+        };
+
+        // A friction peak is a chain of smooth arcs joined at corners: the slip instants move
+        // in steps of one time sample as the phase turns through the resonance, every few
+        // hundredths of a hertz for 300 samples. Each arc has its own local maximum, within
+        // ~1e-5 of the others near the top. The three sampled points place the envelope's
+        // vertex (a parabola through them); a dense scan around it finds the highest arc,
+        // Brent's method then its maximum.
+        let (f0, fm, f1) = (value_at(self, problem, 0.0)?, value_at(self, problem, sm)?, value_at(self, problem, 1.0)?);
+        // Vertex of the parabola through (0, f0), (sm, fm), (1, f1).
+        let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
+        let denominator = d0 - d1;
+        let vertex = if denominator != 0.0 && denominator.is_finite() {
+            (sm - 0.5 * (sm * d0 - (sm - 1.0) * d1) / denominator).clamp(0.0, 1.0)
+        } else {
+            sm
+        };
+        let spacing = 2.0 * WINDOW / SCAN as f64;
+        let first = ((vertex - WINDOW) / spacing).ceil() as i64;
+        let mut samples: Vec<(f64, f64)> = vec![(sm, fm)];
+        for k in first..=first + SCAN as i64 {
+            let s = k as f64 * spacing;
+            if s > 0.0 && s < 1.0 {
+                samples.push((s, value_at(self, problem, s)?));
+            }
         }
+        samples.extend([(0.0, f64::NEG_INFINITY), (1.0, f64::NEG_INFINITY)]);
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let j =
+            (1..samples.len() - 1).max_by(|&a, &b| samples[a].1.total_cmp(&samples[b].1)).expect("interior samples");
+        if samples[j].1.is_finite() {
+            brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| value_at(self, problem, s))?;
+        }
+        let (value, best_z) = best;
+        if !value.is_finite() {
+            return Err(ProblemError::new("no point of the bracket could be solved"));
+        }
+        Ok(Extremum {
+            x: best_z[..n].iter().map(|v| v * x_scale).collect(),
+            lambda: best_z[n] * lambda_scale,
+            value,
+            solves: self.solves - solved_before,
+        })
     }
-    samples.extend([(0.0, f64::NEG_INFINITY), (1.0, f64::NEG_INFINITY)]);
-    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let j = (1..samples.len() - 1).max_by(|&a, &b| samples[a].1.total_cmp(&samples[b].1)).expect("interior samples");
-    if samples[j].1.is_finite() {
-        brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| value_at(problem, s))?;
-    }
-    let (value, best_z) = best;
-    if !value.is_finite() {
-        return Err(ProblemError::new("no point of the bracket could be solved"));
-    }
-    Ok(Extremum {
-        x: best_z[..n].iter().map(|v| v * x_scale).collect(),
-        lambda: best_z[n] * lambda_scale,
-        value,
-        solves,
-    })
 }
 
 /// Locate a zero of `quantity(problem, x, λ)` along the branch of `problem` between two

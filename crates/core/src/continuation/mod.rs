@@ -114,7 +114,7 @@ mod extremum;
 mod linear;
 mod run;
 
-pub use extremum::{maximise_along, zero_along, Extremum};
+pub use extremum::{maximise_along, zero_along, Bracket, Extremum};
 pub use run::continue_branch;
 
 use faer::MatMut;
