@@ -16,25 +16,40 @@ import stickslip
 
 # The Harmony example (66k DOFs at refinement 1.0) runs at the coarse refinement 0.5 (~31k
 # DOFs), as the Rust end-to-end test does, to keep the suite's time reasonable.
-EXAMPLES = ["jenkins-1dof", "jenkins-2dof", "blade-joint", "harmony", "duffing"]
+# Every study file shipped in examples/ (the lap joint has two: its contact patch and the 1-D
+# Jenkins simplification beside it).
+EXAMPLES = [
+    ("jenkins-1dof", "study.toml"),
+    ("jenkins-2dof", "study.toml"),
+    ("blade-joint", "study.toml"),
+    ("harmony", "study.toml"),
+    ("duffing", "study.toml"),
+    ("lap-joint", "study.toml"),
+    ("lap-joint", "study-jenkins.toml"),
+]
 
 
-def study_text(root, name):
-    text = (root / "examples" / name / "study.toml").read_text()
+def test_every_shipped_study_is_compared(root):
+    shipped = {(p.parent.name, p.name) for p in (root / "examples").glob("*/*.toml")}
+    assert shipped == set(EXAMPLES)
+
+
+def study_text(root, name, file="study.toml"):
+    text = (root / "examples" / name / file).read_text()
     if name == "harmony":
         assert "refinement = 1.0" in text
         text = text.replace("refinement = 1.0", "refinement = 0.5")
     return text
 
 
-@pytest.mark.parametrize("name", EXAMPLES)
-def test_python_equals_cli(root, cli, tmp_path, name):
+@pytest.mark.parametrize("name,file", EXAMPLES)
+def test_python_equals_cli(root, cli, tmp_path, name, file):
     # A copy of the example's folder: relative paths (the blade's mesh) resolve as in the
     # repository, and nothing is written there.
     folder = tmp_path / "study"
     shutil.copytree(root / "examples" / name, folder)
-    path = folder / "study.toml"
-    path.write_text(study_text(root, name))
+    path = folder / file
+    path.write_text(study_text(root, name, file))
     p = cli("run", path, "--out", tmp_path / "out", "--quiet", "--no-report", check=False)
     # A level that does not cross the band makes the command fail after writing its points.
     assert p.returncode == 0 or "did not cross the band" in p.stderr, p.stderr
