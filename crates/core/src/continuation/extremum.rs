@@ -174,10 +174,13 @@ impl Bracket {
         } else {
             sm
         };
+        // The window spans the vertex and the middle point: on a friction peak, whose top is a
+        // chain of arcs rather than a parabola, the highest arc may lie near either.
         let spacing = 2.0 * WINDOW / SCAN as f64;
-        let first = ((vertex - WINDOW) / spacing).ceil() as i64;
+        let first = ((vertex.min(sm) - WINDOW) / spacing).ceil() as i64;
+        let last = ((vertex.max(sm) + WINDOW) / spacing).floor() as i64;
         let mut samples: Vec<(f64, f64)> = vec![(sm, fm)];
-        for k in first..=first + SCAN as i64 {
+        for k in first..=last {
             let s = k as f64 * spacing;
             if s > 0.0 && s < 1.0 {
                 samples.push((s, value_at(self, problem, s)?));
