@@ -39,6 +39,27 @@ pub struct ModelArgs {
     /// Density (kg/m^3) of every solid of a mesh.
     #[arg(long, requires_all = ["young", "poisson"])]
     pub density: Option<f64>,
+    /// Fix DOFs of a mesh's node set (a Gmsh physical group, an .inp *NSET): SET=DIRECTIONS,
+    /// directions 1..6 = ux, uy, uz, rx, ry, rz, e.g. --fix ROOT=1,2,3. Repeatable.
+    #[arg(long, value_name = "SET=DIRECTIONS")]
+    pub fix: Vec<String>,
+}
+
+/// `--fix SET=DIRECTIONS`: the set's name and its directions, each in 1..=6.
+fn parse_fix(text: &str) -> anyhow::Result<(String, Vec<u8>)> {
+    let usage = "expected SET=DIRECTIONS with directions 1..6 (ux, uy, uz, rx, ry, rz), e.g. --fix ROOT=1,2,3";
+    let Some((set, directions)) = text.split_once('=') else { bail!("--fix {text}: {usage}") };
+    if set.trim().is_empty() {
+        bail!("--fix {text}: no set named; {usage}");
+    }
+    let directions = directions
+        .split(',')
+        .map(|d| match d.trim().parse::<u8>() {
+            Ok(d @ 1..=6) => Ok(d),
+            _ => Err(anyhow::anyhow!("--fix {text}: direction `{}` is not one of 1..6; {usage}", d.trim())),
+        })
+        .collect::<anyhow::Result<Vec<u8>>>()?;
+    Ok((set.trim().to_string(), directions))
 }
 
 /// The material of `--young`, `--poisson` and `--density`, checked; `None` when not given.
@@ -62,6 +83,13 @@ fn material(args: &ModelArgs) -> anyhow::Result<Option<stickslip_fe::mesh::Mater
 fn assemble_mesh(mut mesh: stickslip_fe::mesh::Mesh, path: &Path, args: &ModelArgs) -> anyhow::Result<Loaded> {
     if let Some(m) = material(args)? {
         mesh.assign_material(None, "COMMAND_LINE", m).with_context(|| format!("{}: the material", path.display()))?;
+    }
+    for fix in &args.fix {
+        let (set, directions) = parse_fix(fix)?;
+        if !mesh.fix_node_set(&set, &directions) {
+            let sets: Vec<&String> = mesh.node_sets.keys().collect();
+            bail!("--fix {fix}: no node set (physical group) `{set}` in {}; its sets are {sets:?}", path.display());
+        }
     }
     eprintln!("assembling {} ...", path.display());
     let fe = FeModel::assemble(mesh).with_context(|| format!("assembling {}", path.display()))?;
@@ -102,6 +130,12 @@ pub fn load(args: &ModelArgs) -> anyhow::Result<Loaded> {
     if args.young.is_some() && !matches!(ext.as_str(), "inp" | "msh") {
         bail!(
             "{}: --young, --poisson and --density give the material of a mesh (.inp or .msh); matrices have theirs",
+            path.display()
+        );
+    }
+    if !args.fix.is_empty() && !matches!(ext.as_str(), "inp" | "msh") {
+        bail!(
+            "{}: --fix fixes DOFs of a mesh's node sets (.inp or .msh); a matrix model's DOFs are fixed where it was exported",
             path.display()
         );
     }

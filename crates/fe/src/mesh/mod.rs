@@ -183,6 +183,20 @@ impl Mesh {
         self.node_sets.get(&name.to_uppercase()).map(|v| v.as_slice())
     }
 
+    /// Fix `directions` (1..=6) of every node of the set `name` (a boundary condition by node
+    /// set or physical group), once each. False, the mesh unchanged, if there is no such set.
+    pub fn fix_node_set(&mut self, name: &str, directions: &[u8]) -> bool {
+        let Some(nodes) = self.node_sets.get(&name.to_uppercase()) else { return false };
+        for &n in nodes {
+            for &d in directions {
+                if !self.fixed.contains(&(n, d)) {
+                    self.fixed.push((n, d));
+                }
+            }
+        }
+        true
+    }
+
     /// Index of the material named `name` (case-insensitive).
     pub fn material(&self, name: &str) -> Option<usize> {
         let name = name.to_uppercase();

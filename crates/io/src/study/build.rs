@@ -836,7 +836,7 @@ fn read_mesh(path: &Path, material: Option<&MaterialSpec>, fixed: &[FixedSet]) -
         mesh.assign_material(None, "STUDY", material).map_err(mesh_error)?;
     }
     for f in fixed {
-        let Some(nodes) = mesh.node_set(&f.set) else {
+        if !mesh.fix_node_set(&f.set, &f.directions) {
             let sets: Vec<&String> = mesh.node_sets.keys().collect();
             return Err(StudyErrorKind::Invalid(format!(
                 "[model] fixed.{}: no node set (physical group) `{}` in {}; its sets are {sets:?}",
@@ -844,12 +844,6 @@ fn read_mesh(path: &Path, material: Option<&MaterialSpec>, fixed: &[FixedSet]) -
                 f.set,
                 path.display()
             )));
-        };
-        let dofs: Vec<(usize, u8)> = nodes.iter().flat_map(|&n| f.directions.iter().map(move |&d| (n, d))).collect();
-        for d in dofs {
-            if !mesh.fixed.contains(&d) {
-                mesh.fixed.push(d);
-            }
         }
     }
     FeModel::assemble(mesh).map_err(|source| StudyErrorKind::Assembly { context: "[model] mesh".into(), source })
