@@ -216,12 +216,13 @@ impl<'m> CondensedHbm<'m> {
         let q = self.q;
         self.element_forces(x, omega, want)?;
         for k in 1..=self.plan.n_harmonics() {
-            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone.
+            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone. The
+            // excitation's response u_F only on harmonic 1, the one it drives.
             let hr = &mut self.harmonic[k - 1];
-            if want {
-                self.receptance.evaluate_matrix(k as f64 * omega, hr);
-            } else {
-                self.receptance.evaluate(k as f64 * omega, hr);
+            match (k, want) {
+                (1, true) => self.receptance.evaluate_matrix(omega, hr),
+                (1, false) => self.receptance.evaluate(omega, hr),
+                _ => self.receptance.evaluate_unforced(k as f64 * omega, hr, want),
             }
         }
         // Harmonic 0: R_0 = x_0 + H(0) G_0.
@@ -239,8 +240,13 @@ impl<'m> CondensedHbm<'m> {
             for (j, a) in self.amplitudes.iter_mut().enumerate() {
                 *a = c64::new(g[ic + j], -g[is + j]);
             }
-            let hr = &self.harmonic[k - 1];
-            self.receptance.apply(hr, &self.amplitudes, &mut self.product);
+            let hr = &mut self.harmonic[k - 1];
+            if want {
+                // H_k is there for the Jacobian: q² products instead of the modal sum's 2qm.
+                multiply(&hr.h, &self.amplitudes, &mut self.product);
+            } else {
+                self.receptance.apply(hr, &self.amplitudes, &mut self.product);
+            }
             for i in 0..q {
                 let mut rc = x[ic + i] + self.product[i].re;
                 let mut rs = x[is + i] - self.product[i].im;
@@ -352,8 +358,10 @@ impl<'m> CondensedHbm<'m> {
             for i in 0..q {
                 dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.joints.dg_domega[j]).sum();
             }
+            // Laws that do not depend on the velocity (sliders) have ∂G/∂Ω = 0: no product.
+            let dg_zero = self.joints.dg_domega.iter().all(|v| *v == 0.0);
             for k in 1..=self.plan.n_harmonics() {
-                let hr = &self.harmonic[k - 1];
+                let hr = &mut self.harmonic[k - 1];
                 let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                 let (g, dg) = (&self.joints.g, &self.joints.dg_domega);
                 // k dH/dω(kΩ) G_k ...
@@ -366,15 +374,19 @@ impl<'m> CondensedHbm<'m> {
                     dw[ic + i] = v.re;
                     dw[is + i] = -v.im;
                 }
-                // ... + H_k ∂G_k/∂Ω − λ_F ∂u_F/∂Ω δ_k1.
-                for (j, a) in self.amplitudes.iter_mut().enumerate() {
-                    *a = c64::new(dg[ic + j], -dg[is + j]);
+                // ... + H_k ∂G_k/∂Ω − λ_F ∂u_F/∂Ω δ_k1, with the matrix H_k of the Jacobian.
+                if !dg_zero {
+                    for (j, a) in self.amplitudes.iter_mut().enumerate() {
+                        *a = c64::new(dg[ic + j], -dg[is + j]);
+                    }
+                    multiply(&hr.h, &self.amplitudes, &mut self.product);
+                    for i in 0..q {
+                        dw[ic + i] += self.product[i].re;
+                        dw[is + i] -= self.product[i].im;
+                    }
                 }
-                self.receptance.apply(hr, &self.amplitudes, &mut self.product);
-                for i in 0..q {
-                    dw[ic + i] += self.product[i].re;
-                    dw[is + i] -= self.product[i].im;
-                    if k == 1 {
+                if k == 1 {
+                    for i in 0..q {
                         dw[ic + i] -= level * hr.du_force[i].re;
                         dw[is + i] += level * hr.du_force[i].im;
                     }
@@ -483,6 +495,13 @@ pub struct Jacobians<'a> {
     pub domega: Option<&'a mut [f64]>,
     /// `∂R/∂λ_F`.
     pub dlevel: Option<&'a mut [f64]>,
+}
+
+/// `h g` for a dense complex matrix (a receptance `H_k` already evaluated).
+fn multiply(h: &Mat<c64>, g: &[c64], out: &mut [c64]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = (0..g.len()).map(|j| h[(i, j)] * g[j]).sum();
+    }
 }
 
 /// Complex amplitude `c − i s` of harmonic `k ≥ 1` of direction/DOF `i` in a coefficient-major
