@@ -313,36 +313,40 @@ impl<'m> CondensedHbm<'m> {
         for i in 0..q * nc {
             dx[(i, i)] = 1.0;
         }
+        let (h0, harmonic) = (&self.h0, &self.harmonic);
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
                 for b in 0..d {
+                    // One column of ∂R/∂x and of the element's block, as contiguous slices
+                    // (this runs at every Newton iteration).
                     let col = c2 * q + off + b;
-                    let ecol = c2 * d + b;
-                    for i in 0..q {
+                    let jcol = je.col_as_slice(c2 * d + b);
+                    let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
+                    for (i, out) in column[..q].iter_mut().enumerate() {
                         let mut v = 0.0;
                         for a in 0..d {
-                            v += self.h0[(i, off + a)] * je[(a, ecol)];
+                            v += h0.col_as_slice(off + a)[i] * jcol[a];
                         }
-                        dx[(i, col)] += v;
+                        *out += v;
                     }
                     for k in 1..=self.plan.n_harmonics() {
-                        let hr = &self.harmonic[k - 1];
+                        let h = &harmonic[k - 1].h;
                         let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                         let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
                         for i in 0..q {
                             let mut vc = 0.0;
                             let mut vs = 0.0;
                             for a in 0..d {
-                                let h = hr.h[(i, off + a)];
-                                let (gc, gs) = (je[(ec + a, ecol)], je[(es + a, ecol)]);
+                                let h = h.col_as_slice(off + a)[i];
+                                let (gc, gs) = (jcol[ec + a], jcol[es + a]);
                                 vc += h.re * gc + h.im * gs;
                                 vs += -h.im * gc + h.re * gs;
                             }
-                            dx[(ic + i, col)] += vc;
-                            dx[(is + i, col)] += vs;
+                            column[ic + i] += vc;
+                            column[is + i] += vs;
                         }
                     }
                 }

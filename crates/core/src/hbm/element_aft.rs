@@ -223,32 +223,48 @@ impl ElementAft {
             if chain_rule {
                 self.sens_period_start.copy_from_slice(&self.sens);
             }
-            for i in 0..nt {
-                let j = (j0 + i) % nt;
-                self.load_sample(j);
-                self.state_before.copy_from_slice(&self.state);
-                law.update(
-                    &self.u_now,
-                    &self.v_now,
-                    &mut self.state,
-                    &mut self.g_now,
-                    // The closed-form slider Jacobian needs only the slip flags, not the tangent.
-                    if chain_rule { Some(&mut self.tangent) } else { None },
-                );
-                for a in 0..d {
-                    self.g[a * nt + j] = self.g_now[a];
-                }
-                self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
-                if chain_rule {
-                    self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
-                } else if want_jac {
-                    if self.slipping[j] {
-                        anchor = Some(j);
+            if slider.is_some() {
+                // The same steps in three stretches (the first sample alone, for the state
+                // after it), then the anchors from the slip flags.
+                let mut w = self.state[0];
+                for (n, range) in [j0..j0 + 1, j0 + 1..nt, 0..j0].into_iter().enumerate() {
+                    law.update_slider_samples(&self.u, &self.v, range, &mut w, &mut self.g, &mut self.slipping);
+                    if n == 0 {
+                        self.state_after_start[0] = w;
                     }
-                    self.anchor[j] = anchor.unwrap_or(usize::MAX);
                 }
-                if i == 0 {
-                    self.state_after_start.copy_from_slice(&self.state);
+                self.state[0] = w;
+                if want_jac {
+                    for i in 0..nt {
+                        let j = wrap(j0 + i, nt);
+                        if self.slipping[j] {
+                            anchor = Some(j);
+                        }
+                        self.anchor[j] = anchor.unwrap_or(usize::MAX);
+                    }
+                }
+            } else {
+                for i in 0..nt {
+                    let j = (j0 + i) % nt;
+                    self.load_sample(j);
+                    self.state_before.copy_from_slice(&self.state);
+                    law.update(
+                        &self.u_now,
+                        &self.v_now,
+                        &mut self.state,
+                        &mut self.g_now,
+                        if chain_rule { Some(&mut self.tangent) } else { None },
+                    );
+                    for a in 0..d {
+                        self.g[a * nt + j] = self.g_now[a];
+                    }
+                    self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
+                    if chain_rule {
+                        self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
+                    }
+                    if i == 0 {
+                        self.state_after_start.copy_from_slice(&self.state);
+                    }
                 }
             }
             if !hysteretic {
@@ -345,11 +361,10 @@ impl ElementAft {
             }
         }
         // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order.
-        let p = plan.projection();
         let mut current = usize::MAX;
         self.coeff_buf.iter_mut().for_each(|v| *v = 0.0);
         for i in 0..=nt {
-            let j = (j0 + i) % nt;
+            let j = wrap(j0 + i, nt);
             let a = if i == nt || self.slipping[j] { usize::MAX } else { self.anchor[j] };
             if a != current {
                 if current != usize::MAX {
@@ -365,8 +380,8 @@ impl ElementAft {
                 current = a;
             }
             if current != usize::MAX {
-                for c in 0..nc {
-                    self.coeff_buf[c] += p[(c, j)];
+                for (b, pc) in self.coeff_buf.iter_mut().zip(plan.projection_at(j)) {
+                    *b += pc;
                 }
             }
         }
@@ -508,6 +523,16 @@ impl ElementAft {
             }
         }
         std::mem::swap(&mut self.sens, &mut self.sens_next);
+    }
+}
+
+/// `j mod n_t` for `j < 2 n_t`: a sample index in marching order, without a division.
+#[inline]
+fn wrap(j: usize, nt: usize) -> usize {
+    if j >= nt {
+        j - nt
+    } else {
+        j
     }
 }
 
