@@ -83,6 +83,11 @@ pub struct CondensedHbm<'m> {
     factored: Option<StructuredJacobian>,
     /// Solve Newton systems by [`StructuredJacobian`] rather than a dense LU.
     by_structure: bool,
+    /// Every element is a slider, whose Jacobian follows from a residual evaluation's slip
+    /// flags ([`Self::complete_jacobian`]).
+    sliders_only: bool,
+    /// Ω and λ_F of the last evaluation.
+    last: Option<(f64, f64)>,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -118,6 +123,14 @@ impl<'m> CondensedHbm<'m> {
             product: vec![c64::new(0.0, 0.0); q],
             factored: None,
             by_structure: q * plan.n_coeffs() >= FACTOR_BY_STRUCTURE_FROM,
+            sliders_only: model.elements.iter().all(|e| {
+                let law = e.law.as_ref();
+                law.slider_stiffness().is_some()
+                    && law.n_dirs() == 1
+                    && law.n_state() == 1
+                    && !law.depends_on_velocity()
+            }),
+            last: None,
             plan,
             evaluations: 0,
         })
@@ -213,6 +226,7 @@ impl<'m> CondensedHbm<'m> {
         want: bool,
     ) -> Result<(), HbmError> {
         self.evaluations += 1;
+        self.last = None;
         let q = self.q;
         self.element_forces(x, omega, want)?;
         for k in 1..=self.plan.n_harmonics() {
@@ -258,7 +272,38 @@ impl<'m> CondensedHbm<'m> {
                 residual[is + i] = rs;
             }
         }
+        self.last = Some((omega, level));
         Ok(())
+    }
+
+    /// Can [`Self::complete_jacobian`] follow a residual evaluation (dense Newton systems,
+    /// every element a slider)?
+    pub fn completes_jacobian(&self) -> bool {
+        self.sliders_only && !self.by_structure
+    }
+
+    /// `∂R/∂x` and, as asked, `∂R/∂Ω`, `∂R/∂λ_F` at the point of the last [`Self::evaluate`],
+    /// made for the residual alone, as an evaluation with them would have written them: the
+    /// sliders' Jacobians from their slip flags, the matrices `H_k` at the same Ω. What
+    /// Newton needs at the iterates it does not accept, without evaluating their residual
+    /// twice. False, nothing written, when [`Self::completes_jacobian`] is false or there was
+    /// no evaluation.
+    pub fn complete_jacobian(
+        &mut self,
+        dx: MatMut<'_, f64>,
+        domega: Option<&mut [f64]>,
+        dlevel: Option<&mut [f64]>,
+    ) -> bool {
+        let Some((omega, level)) = self.last.filter(|_| self.completes_jacobian()) else { return false };
+        if !self.joints.complete_jacobian(self.model, &self.plan) {
+            return false;
+        }
+        for (k, hr) in self.harmonic.iter_mut().enumerate() {
+            self.receptance.complete_matrix((k + 1) as f64 * omega, hr);
+        }
+        self.assemble_jacobian(dx, self.plan.n_coeffs());
+        self.parameter_derivatives(level, domega, dlevel);
+        true
     }
 
     /// [`Self::evaluate`] with `∂R/∂x` factored by its structure ([`StructuredJacobian`])

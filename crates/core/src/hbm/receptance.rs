@@ -198,6 +198,16 @@ impl Receptance {
         }
     }
 
+    /// The matrix `H(ω)` into `out`, after an evaluation at ω without it: what
+    /// [`Self::evaluate_matrix`] adds to [`Self::evaluate`], from the modal weights already
+    /// there (the same values).
+    pub fn complete_matrix(&self, omega: f64, out: &mut HarmonicReceptance) {
+        match self {
+            Receptance::Modal(m) => m.matrix(out),
+            Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
     /// `H(ω) g` for complex force amplitudes `g` (q), with `hr` from an evaluation at ω.
     pub fn apply(&self, hr: &mut HarmonicReceptance, g: &[c64], out: &mut [c64]) {
         match self {
@@ -314,9 +324,15 @@ impl ModalReceptance {
                 out.du_force[i] = c64::new(re, im);
             }
         }
-        if !matrix {
-            return;
+        if matrix {
+            self.matrix(out);
         }
+    }
+
+    /// `H = A diag(1/den) Aᵀ` into `out.h` from the weights `out` holds.
+    fn matrix(&self, out: &mut HarmonicReceptance) {
+        let (q, m) = (self.a.nrows(), self.omega_r.len());
+        let [inv_re, inv_im] = &out.inverse;
         if q <= PAIRWISE_UP_TO {
             for (p, (i, j)) in lower_pairs(q).enumerate() {
                 let (re, im) = dot2(&self.pairs[p * m..(p + 1) * m], inv_re, inv_im);
