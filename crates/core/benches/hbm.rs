@@ -328,7 +328,8 @@ fn main() {
         println!("  bordered LU (61 x 61) and solve {lu:.1} us");
         println!(
             "  accounted per point {accounted:.1} us ({:.1} residuals, {:.1} completions, {:.1} LU) of {per_point:.1} \
-             us measured (the rest: the continuation's own work, caches colder than in these repeated calls)",
+             us measured (the rest: the continuation's own work, colder caches and, on a loaded machine, \
+             waiting for a core)",
             residuals * res,
             jacobians * jcb,
             factorizations * lu
