@@ -10,7 +10,10 @@ use faer::linalg::solvers::Solve;
 use faer::Mat;
 use stickslip_core::continuation::{Options, Silent, TerminationReason};
 use stickslip_core::elements::{Contact, Element};
-use stickslip_core::hbm::{stability_at, sweep_frequency, CondensedHbm, HbmSettings, Hill, HillSettings, Jacobians};
+use stickslip_core::hbm::receptance::HarmonicReceptance;
+use stickslip_core::hbm::{
+    stability_at, sweep_frequency, CondensedHbm, ElementAft, HbmSettings, Hill, HillSettings, Jacobians,
+};
 use stickslip_core::model::{relative_direction, ElementSite, NonlinearModel};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -159,11 +162,12 @@ fn patch_newton_iteration(
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "quick");
-    // Optional filters: `table6`, `paper`, `cost`, `contact`, `stability`, `patch` (default: all).
+    // Optional filters: `table6`, `paper`, `profile`, `cost`, `contact`, `stability`, `patch`
+    // (default: all).
     let wanted = |name: &str| {
         let filters: Vec<&String> = args
             .iter()
-            .filter(|a| ["table6", "paper", "cost", "contact", "stability", "patch"].contains(&a.as_str()))
+            .filter(|a| ["table6", "paper", "profile", "cost", "contact", "stability", "patch"].contains(&a.as_str()))
             .collect();
         filters.is_empty() || filters.iter().any(|f| *f == name)
     };
@@ -191,6 +195,145 @@ fn main() {
             print_sweep(&format!("137 DOFs, q = 4, {level} N, 170-300 Hz"), &f);
         }
         println!("{:<44} {:>9.3} ms for the 6 levels", "137 DOFs, q = 4, all levels", total * 1e3);
+    }
+    if wanted("profile") {
+        // Where a paper-size level's time goes (2910 N, where the joints slip): the calls the
+        // continuation made per point, and each kind of call timed alone at the branch's own
+        // points (median over the points of repeated timings).
+        let paper = chain_with_joints(137, 4, false);
+        let mut force = vec![0.0; 137];
+        force[136] = 1.0;
+        let settings = HbmSettings { harmonics: 7, samples: 300 };
+        let timed = |f: &mut dyn FnMut()| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        };
+        let setup = median(
+            (0..runs)
+                .map(|_| {
+                    timed(&mut || drop(std::hint::black_box(CondensedHbm::new(&paper, &force, settings).unwrap())))
+                })
+                .collect(),
+        );
+        let mut hbm = CondensedHbm::new(&paper, &force, settings).unwrap();
+        let sweeps: Vec<f64> = (0..runs)
+            .map(|_| {
+                timed(&mut || {
+                    sweep_frequency(&mut hbm, 2910.0, TWO_PI * 170.0, TWO_PI * 300.0, &options, &mut Silent).unwrap();
+                })
+            })
+            .collect();
+        let sweep_seconds = median(sweeps);
+        let branch = sweep_frequency(&mut hbm, 2910.0, TWO_PI * 170.0, TWO_PI * 300.0, &options, &mut Silent).unwrap();
+        let points = branch.points.len() as f64;
+        // The corrector evaluates residuals and completes to Jacobians those it does not
+        // accept (`CondensedHbm::complete_jacobian`, every joint a slider).
+        assert!(hbm.completes_jacobian());
+        let (residuals, jacobians, factorizations) = (
+            branch.calls.residuals as f64 / points,
+            branch.calls.jacobians as f64 / points,
+            branch.calls.factorizations as f64 / points,
+        );
+        // Each call alone at every point of the branch.
+        let (dim, q) = (hbm.dimension(), hbm.n_directions());
+        let plan = hbm.plan();
+        let mut afts: Vec<ElementAft> = paper.elements.iter().map(|e| ElementAft::new(e.law.as_ref(), plan)).collect();
+        let nc = plan.n_coeffs();
+        let receptance = hbm.receptance();
+        let mut harmonic: Vec<HarmonicReceptance> = (0..7).map(|_| HarmonicReceptance::new(q)).collect();
+        let (mut u, mut g, mut block, mut dgdw) = (vec![0.0; nc], vec![0.0; nc], Mat::zeros(nc, nc), vec![0.0; nc]);
+        // The AFT of the 4 joints without Jacobian, then (`complete`) their Jacobians from it.
+        let mut aft_alone = |x: &[f64], omega: f64, complete: bool| {
+            for (e, (site, aft)) in paper.elements.iter().zip(&mut afts).enumerate() {
+                for c in 0..nc {
+                    u[c] = x[c * q + e];
+                }
+                aft.evaluate(site.law.as_ref(), plan, omega, &u, &mut g, None).unwrap();
+                if complete {
+                    assert!(aft.complete_slider_jacobian(plan, block.as_mut(), &mut dgdw));
+                }
+            }
+        };
+        // The receptance at the 7 harmonics for a residual, then (`complete`) the matrices H_k.
+        let mut receptance_alone = |omega: f64, complete: bool| {
+            for (k, hr) in harmonic.iter_mut().enumerate() {
+                let w = (k + 1) as f64 * omega;
+                match k {
+                    0 => receptance.evaluate(w, hr),
+                    _ => receptance.evaluate_unforced(w, hr, false),
+                }
+                if complete {
+                    receptance.complete_matrix(w, hr);
+                }
+            }
+        };
+        let repeat_at = |f: &mut dyn FnMut()| median((0..5).map(|_| timed(f)).collect());
+        let mut t = [Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+        for p in &branch.points {
+            t[0].push(repeat_at(&mut || aft_alone(&p.x, p.lambda, false)));
+            t[1].push(repeat_at(&mut || aft_alone(&p.x, p.lambda, true)));
+            t[2].push(repeat_at(&mut || receptance_alone(p.lambda, false)));
+            t[3].push(repeat_at(&mut || receptance_alone(p.lambda, true)));
+        }
+        let mut r = vec![0.0; dim];
+        let mut jac = Mat::zeros(dim, dim);
+        let mut dw = vec![0.0; dim];
+        let (mut residual_t, mut jacobian_t) = (Vec::new(), Vec::new());
+        for p in &branch.points {
+            residual_t.push(repeat_at(&mut || hbm.evaluate(&p.x, p.lambda, 2910.0, &mut r, None).unwrap()));
+            jacobian_t.push(repeat_at(&mut || {
+                hbm.evaluate(&p.x, p.lambda, 2910.0, &mut r, None).unwrap();
+                assert!(hbm.complete_jacobian(jac.as_mut(), Some(&mut dw), None));
+            }));
+            // The bordered (n+1) system of the corrector, factored and solved.
+            let bordered = Mat::from_fn(dim + 1, dim + 1, |i, j| match (i < dim, j < dim) {
+                (true, true) => jac[(i, j)],
+                (true, false) => dw[i],
+                _ => 1.0,
+            });
+            let rhs = Mat::from_fn(dim + 1, 1, |i, _| if i < dim { r[i] } else { 0.0 });
+            t[4].push(repeat_at(&mut || drop(std::hint::black_box(bordered.partial_piv_lu().solve(&rhs)))));
+        }
+        let us = |v: Vec<f64>| median(v) * 1e6;
+        let [aft_r, aft_j, rec_r, rec_j, lu] = t.map(us);
+        let res = us(residual_t);
+        // Completions by difference: the residual, then the residual and its completion.
+        let jcb = us(jacobian_t) - res;
+        let (aft_j, rec_j) = (aft_j - aft_r, rec_j - rec_r);
+        let accounted = jacobians * jcb + residuals * res + factorizations * lu;
+        let per_point = sweep_seconds * 1e6 / points;
+        println!(
+            "profile, 137 DOFs, q = 4, 2910 N, 170-300 Hz: {} points, sweep {:.2} ms ({:.1} us/point), set-up \
+             (modes, receptance) {:.2} ms",
+            branch.points.len(),
+            sweep_seconds * 1e3,
+            per_point,
+            setup * 1e3
+        );
+        println!(
+            "  per point: {residuals:.2} residuals, {jacobians:.2} completed to Jacobians, {factorizations:.2} \
+             bordered LU solves"
+        );
+        println!(
+            "  residual   {res:>6.1} us: AFT of the 4 joints {aft_r:.1}, receptance at 7 harmonics {rec_r:.1}, \
+             products H_k G_k {:.1}",
+            res - aft_r - rec_r
+        );
+        println!(
+            "  completion {jcb:>6.1} us: sliders' Jacobians {aft_j:.1}, matrices H_k {rec_j:.1}, 60 x 60 assembly and \
+             dR/dOmega {:.1}",
+            jcb - aft_j - rec_j
+        );
+        println!("  bordered LU (61 x 61) and solve {lu:.1} us");
+        println!(
+            "  accounted per point {accounted:.1} us ({:.1} residuals, {:.1} completions, {:.1} LU) of {per_point:.1} \
+             us measured (the rest: the continuation's own work, colder caches and, on a loaded machine, \
+             waiting for a core)",
+            residuals * res,
+            jacobians * jcb,
+            factorizations * lu
+        );
     }
     if wanted("stability") {
         // Hill's method on every point of a paper-size sweep (2910 N, where the joints slip):

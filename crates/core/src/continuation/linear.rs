@@ -25,6 +25,9 @@ pub(super) struct Workspace {
     scratch: MemBuffer,
     /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
     factored: bool,
+    /// Dense, and the problem completes a residual evaluation to its Jacobian
+    /// ([`Problem::completes_jacobian`]).
+    pub lazy: bool,
     /// Factored: the last factorisation was singular.
     singular: bool,
     /// Factored: `(∂R/∂x)⁻¹ ∂R/∂λ` for the border.
@@ -46,6 +49,7 @@ impl Workspace {
             n,
             matrix: Mat::zeros(size, size),
             factored,
+            lazy: !factored && problem.completes_jacobian(),
             singular: false,
             border: if factored { vec![0.0; n] } else { Vec::new() },
             dr_dlambda: vec![0.0; n],
@@ -79,6 +83,16 @@ impl Workspace {
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
         problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))
+    }
+
+    /// `∂R/∂x` (dense, into the matrix) and `∂R/∂λ` at the point of the last evaluation, which
+    /// was of the residual alone (only when [`Self::lazy`]).
+    pub fn complete<P: Problem + ?Sized>(&mut self, problem: &mut P) -> Result<(), ProblemError> {
+        let n = self.n;
+        self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
+        let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
+        jx.fill(0.0);
+        problem.complete_jacobian((jx, &mut self.dr_dlambda))
     }
 
     /// Solve the bordered system of Eq. 32 in scaled variables,

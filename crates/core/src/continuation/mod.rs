@@ -148,6 +148,21 @@ pub trait Problem {
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
         None
     }
+
+    /// Can [`Self::complete_jacobian`] give the Jacobian at the point of the last residual
+    /// evaluation for less than evaluating there again? Then the corrector evaluates residuals
+    /// alone and completes only those it does not accept: the Jacobian at a converged point is
+    /// never computed. Same iterates either way. Default: no.
+    fn completes_jacobian(&self) -> bool {
+        false
+    }
+
+    /// `∂R/∂x` and `∂R/∂λ` (buffers as for [`Self::evaluate`], zeroed) at the point of the last
+    /// [`Self::evaluate`], which was asked for the residual alone; called only when
+    /// [`Self::completes_jacobian`].
+    fn complete_jacobian(&mut self, _jacobian: (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
+        Err(ProblemError::new("this problem does not complete a residual evaluation to a Jacobian"))
+    }
 }
 
 /// `∂R/∂x` factored by the problem itself ([`Problem::factored`]).

@@ -555,14 +555,17 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             for (x, u) in self.x_phys.iter_mut().zip(&self.z) {
                 *x = u * self.scale.x;
             }
-            if !jacobian_at_solution && iterations >= 2 && old * old / older <= 0.1 * self.tolerance {
+            // A problem that completes residuals to Jacobians: the residual alone, the Jacobian
+            // only if the iterate is not accepted (below).
+            let lazy = self.ws.lazy && !jacobian_at_solution;
+            if !lazy && !jacobian_at_solution && iterations >= 2 && old * old / older <= 0.1 * self.tolerance {
                 match self.evaluate(lambda, false) {
                     Ok(r) if r <= self.tolerance => return Outcome::Converged { iterations, residual_norm: r },
                     Ok(_) => {}
                     Err(error) => return self.problem_outcome(iterations, lambda, error),
                 }
             }
-            let residual_norm = match self.evaluate(lambda, true) {
+            let residual_norm = match self.evaluate(lambda, !lazy) {
                 Ok(r) => r,
                 Err(error) => return self.problem_outcome(iterations, lambda, error),
             };
@@ -582,6 +585,14 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                     Rejection::NoConvergence
                 };
                 return Outcome::Failed { iterations, residual_norm, cause };
+            }
+            if lazy {
+                let calls = Calls { residuals: 0, jacobians: 1, factorizations: 0 };
+                self.calls += calls;
+                self.total += calls;
+                if let Err(error) = self.ws.complete(self.problem) {
+                    return self.problem_outcome(iterations, lambda, error);
+                }
             }
             let sr = self.scale.residual;
             for (b, r) in self.ws.rhs.iter_mut().zip(&self.ws.residual) {

@@ -83,17 +83,19 @@ impl Element for Jenkins {
     /// `w = u_max − F_c/k`, whatever happened before.
     fn periodic_start(&self, u: &[f64], n_t: usize, state: &mut [f64], dstate_du: &mut [f64]) -> Option<usize> {
         let u = &u[..n_t];
-        let (mut j_max, mut u_min) = (0, u[0]);
+        // The largest value kept in a register rather than read back at j_max: the same first
+        // maximum, without a load on the loop's dependency chain.
+        let (mut j_max, mut u_max, mut u_min) = (0, u[0], u[0]);
         for (j, &x) in u.iter().enumerate() {
-            if x > u[j_max] {
-                j_max = j;
+            if x > u_max {
+                (j_max, u_max) = (j, x);
             }
             u_min = u_min.min(x);
         }
-        if self.stiffness * (u[j_max] - u_min) <= 2.0 * self.threshold {
+        if self.stiffness * (u_max - u_min) <= 2.0 * self.threshold {
             return None;
         }
-        state[0] = u[j_max] - self.threshold / self.stiffness;
+        state[0] = u_max - self.threshold / self.stiffness;
         dstate_du[0] = 1.0;
         Some(j_max)
     }

@@ -142,6 +142,31 @@ pub trait Element: Send + Sync + std::fmt::Debug {
         0.0
     }
 
+    /// For a slider ([`Element::slider_stiffness`]: one direction, one state, no velocity):
+    /// [`Element::update`] at the samples `range` of the motion `u`, `v` in order, from `state`
+    /// (updated), each force into `g[j]` and [`Element::is_slipping`] of each step into
+    /// `slipping[j]`. The same steps as calling both per sample; one call per stretch of a
+    /// period lets them inline (the AFT runs this for every sample at every Newton iteration).
+    fn update_slider_samples(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        range: std::ops::Range<usize>,
+        state: &mut f64,
+        g: &mut [f64],
+        slipping: &mut [bool],
+    ) {
+        let mut after = [*state];
+        let mut force = [0.0];
+        for j in range {
+            let before = after;
+            self.update(&u[j..j + 1], &v[j..j + 1], &mut after, &mut force, None);
+            g[j] = force[0];
+            slipping[j] = self.is_slipping(&before, &after);
+        }
+        *state = after[0];
+    }
+
     /// Is the element slipping over this step (state before → after)? Used for the stick
     /// fraction and the slider velocity (Eq. 33). Memoryless laws never stick.
     fn is_slipping(&self, state_before: &[f64], state_after: &[f64]) -> bool {

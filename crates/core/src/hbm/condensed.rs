@@ -83,6 +83,11 @@ pub struct CondensedHbm<'m> {
     factored: Option<StructuredJacobian>,
     /// Solve Newton systems by [`StructuredJacobian`] rather than a dense LU.
     by_structure: bool,
+    /// Every element is a slider, whose Jacobian follows from a residual evaluation's slip
+    /// flags ([`Self::complete_jacobian`]).
+    sliders_only: bool,
+    /// Ω and λ_F of the last evaluation.
+    last: Option<(f64, f64)>,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -118,6 +123,14 @@ impl<'m> CondensedHbm<'m> {
             product: vec![c64::new(0.0, 0.0); q],
             factored: None,
             by_structure: q * plan.n_coeffs() >= FACTOR_BY_STRUCTURE_FROM,
+            sliders_only: model.elements.iter().all(|e| {
+                let law = e.law.as_ref();
+                law.slider_stiffness().is_some()
+                    && law.n_dirs() == 1
+                    && law.n_state() == 1
+                    && !law.depends_on_velocity()
+            }),
+            last: None,
             plan,
             evaluations: 0,
         })
@@ -213,15 +226,17 @@ impl<'m> CondensedHbm<'m> {
         want: bool,
     ) -> Result<(), HbmError> {
         self.evaluations += 1;
+        self.last = None;
         let q = self.q;
         self.element_forces(x, omega, want)?;
         for k in 1..=self.plan.n_harmonics() {
-            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone.
+            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone. The
+            // excitation's response u_F only on harmonic 1, the one it drives.
             let hr = &mut self.harmonic[k - 1];
-            if want {
-                self.receptance.evaluate_matrix(k as f64 * omega, hr);
-            } else {
-                self.receptance.evaluate(k as f64 * omega, hr);
+            match (k, want) {
+                (1, true) => self.receptance.evaluate_matrix(omega, hr),
+                (1, false) => self.receptance.evaluate(omega, hr),
+                _ => self.receptance.evaluate_unforced(k as f64 * omega, hr, want),
             }
         }
         // Harmonic 0: R_0 = x_0 + H(0) G_0.
@@ -239,8 +254,13 @@ impl<'m> CondensedHbm<'m> {
             for (j, a) in self.amplitudes.iter_mut().enumerate() {
                 *a = c64::new(g[ic + j], -g[is + j]);
             }
-            let hr = &self.harmonic[k - 1];
-            self.receptance.apply(hr, &self.amplitudes, &mut self.product);
+            let hr = &mut self.harmonic[k - 1];
+            if want {
+                // H_k is there for the Jacobian: q² products instead of the modal sum's 2qm.
+                multiply(&hr.h, &self.amplitudes, &mut self.product);
+            } else {
+                self.receptance.apply(hr, &self.amplitudes, &mut self.product);
+            }
             for i in 0..q {
                 let mut rc = x[ic + i] + self.product[i].re;
                 let mut rs = x[is + i] - self.product[i].im;
@@ -252,7 +272,38 @@ impl<'m> CondensedHbm<'m> {
                 residual[is + i] = rs;
             }
         }
+        self.last = Some((omega, level));
         Ok(())
+    }
+
+    /// Can [`Self::complete_jacobian`] follow a residual evaluation (dense Newton systems,
+    /// every element a slider)?
+    pub fn completes_jacobian(&self) -> bool {
+        self.sliders_only && !self.by_structure
+    }
+
+    /// `∂R/∂x` and, as asked, `∂R/∂Ω`, `∂R/∂λ_F` at the point of the last [`Self::evaluate`],
+    /// made for the residual alone, as an evaluation with them would have written them: the
+    /// sliders' Jacobians from their slip flags, the matrices `H_k` at the same Ω. What
+    /// Newton needs at the iterates it does not accept, without evaluating their residual
+    /// twice. False, nothing written, when [`Self::completes_jacobian`] is false or there was
+    /// no evaluation.
+    pub fn complete_jacobian(
+        &mut self,
+        dx: MatMut<'_, f64>,
+        domega: Option<&mut [f64]>,
+        dlevel: Option<&mut [f64]>,
+    ) -> bool {
+        let Some((omega, level)) = self.last.filter(|_| self.completes_jacobian()) else { return false };
+        if !self.joints.complete_jacobian(self.model, &self.plan) {
+            return false;
+        }
+        for (k, hr) in self.harmonic.iter_mut().enumerate() {
+            self.receptance.complete_matrix((k + 1) as f64 * omega, hr);
+        }
+        self.assemble_jacobian(dx, self.plan.n_coeffs());
+        self.parameter_derivatives(level, domega, dlevel);
+        true
     }
 
     /// [`Self::evaluate`] with `∂R/∂x` factored by its structure ([`StructuredJacobian`])
@@ -307,36 +358,40 @@ impl<'m> CondensedHbm<'m> {
         for i in 0..q * nc {
             dx[(i, i)] = 1.0;
         }
+        let (h0, harmonic) = (&self.h0, &self.harmonic);
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
                 for b in 0..d {
+                    // One column of ∂R/∂x and of the element's block, as contiguous slices
+                    // (this runs at every Newton iteration).
                     let col = c2 * q + off + b;
-                    let ecol = c2 * d + b;
-                    for i in 0..q {
+                    let jcol = je.col_as_slice(c2 * d + b);
+                    let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
+                    for (i, out) in column[..q].iter_mut().enumerate() {
                         let mut v = 0.0;
                         for a in 0..d {
-                            v += self.h0[(i, off + a)] * je[(a, ecol)];
+                            v += h0.col_as_slice(off + a)[i] * jcol[a];
                         }
-                        dx[(i, col)] += v;
+                        *out += v;
                     }
                     for k in 1..=self.plan.n_harmonics() {
-                        let hr = &self.harmonic[k - 1];
+                        let h = &harmonic[k - 1].h;
                         let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                         let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
                         for i in 0..q {
                             let mut vc = 0.0;
                             let mut vs = 0.0;
                             for a in 0..d {
-                                let h = hr.h[(i, off + a)];
-                                let (gc, gs) = (je[(ec + a, ecol)], je[(es + a, ecol)]);
+                                let h = h.col_as_slice(off + a)[i];
+                                let (gc, gs) = (jcol[ec + a], jcol[es + a]);
                                 vc += h.re * gc + h.im * gs;
                                 vs += -h.im * gc + h.re * gs;
                             }
-                            dx[(ic + i, col)] += vc;
-                            dx[(is + i, col)] += vs;
+                            column[ic + i] += vc;
+                            column[is + i] += vs;
                         }
                     }
                 }
@@ -352,8 +407,10 @@ impl<'m> CondensedHbm<'m> {
             for i in 0..q {
                 dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.joints.dg_domega[j]).sum();
             }
+            // Laws that do not depend on the velocity (sliders) have ∂G/∂Ω = 0: no product.
+            let dg_zero = self.joints.dg_domega.iter().all(|v| *v == 0.0);
             for k in 1..=self.plan.n_harmonics() {
-                let hr = &self.harmonic[k - 1];
+                let hr = &mut self.harmonic[k - 1];
                 let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                 let (g, dg) = (&self.joints.g, &self.joints.dg_domega);
                 // k dH/dω(kΩ) G_k ...
@@ -366,15 +423,19 @@ impl<'m> CondensedHbm<'m> {
                     dw[ic + i] = v.re;
                     dw[is + i] = -v.im;
                 }
-                // ... + H_k ∂G_k/∂Ω − λ_F ∂u_F/∂Ω δ_k1.
-                for (j, a) in self.amplitudes.iter_mut().enumerate() {
-                    *a = c64::new(dg[ic + j], -dg[is + j]);
+                // ... + H_k ∂G_k/∂Ω − λ_F ∂u_F/∂Ω δ_k1, with the matrix H_k of the Jacobian.
+                if !dg_zero {
+                    for (j, a) in self.amplitudes.iter_mut().enumerate() {
+                        *a = c64::new(dg[ic + j], -dg[is + j]);
+                    }
+                    multiply(&hr.h, &self.amplitudes, &mut self.product);
+                    for i in 0..q {
+                        dw[ic + i] += self.product[i].re;
+                        dw[is + i] -= self.product[i].im;
+                    }
                 }
-                self.receptance.apply(hr, &self.amplitudes, &mut self.product);
-                for i in 0..q {
-                    dw[ic + i] += self.product[i].re;
-                    dw[is + i] -= self.product[i].im;
-                    if k == 1 {
+                if k == 1 {
+                    for i in 0..q {
                         dw[ic + i] -= level * hr.du_force[i].re;
                         dw[is + i] += level * hr.du_force[i].im;
                     }
@@ -483,6 +544,13 @@ pub struct Jacobians<'a> {
     pub domega: Option<&'a mut [f64]>,
     /// `∂R/∂λ_F`.
     pub dlevel: Option<&'a mut [f64]>,
+}
+
+/// `h g` for a dense complex matrix (a receptance `H_k` already evaluated).
+fn multiply(h: &Mat<c64>, g: &[c64], out: &mut [c64]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = (0..g.len()).map(|j| h[(i, j)] * g[j]).sum();
+    }
 }
 
 /// Complex amplitude `c − i s` of harmonic `k ≥ 1` of direction/DOF `i` in a coefficient-major

@@ -67,7 +67,8 @@ pub struct ElementAft {
     s: usize,
     nc: usize,
     nt: usize,
-    /// Displacement and velocity samples, `u[a * nt + j]`.
+    /// Displacement and velocity samples, `u[a * nt + j]`; the velocity only for a law that
+    /// depends on it ([`Element::depends_on_velocity`]; zero otherwise).
     pub u: Vec<f64>,
     pub v: Vec<f64>,
     /// Force samples of the periodic regime, `g[a * nt + j]`.
@@ -92,6 +93,10 @@ pub struct ElementAft {
     /// `(k, first marched sample)` when the last Jacobian was a slider's closed form: what
     /// [`Self::add_memory_delay`] needs.
     slider_jacobian_of: Option<(f64, usize)>,
+    /// `(k, k_r, first marched sample)` of the last evaluation if the law is a slider, whose
+    /// Jacobian [`Self::complete_slider_jacobian`] builds afterwards from the slip flags and
+    /// anchors (kept by every evaluation of a slider).
+    last_slider: Option<(f64, f64, usize)>,
     /// Fourier sums of the stick weights, cos and sin, harmonics 0..=2N.
     weight_cos: Vec<f64>,
     weight_sin: Vec<f64>,
@@ -136,6 +141,7 @@ impl ElementAft {
             sens_period_start: vec![0.0; s * cols],
             anchor: vec![usize::MAX; nt],
             slider_jacobian_of: None,
+            last_slider: None,
             weight_cos: vec![0.0; 2 * (nc / 2) + 1],
             weight_sin: vec![0.0; 2 * (nc / 2) + 1],
             tangent: Tangent::new(d, s),
@@ -166,19 +172,23 @@ impl ElementAft {
     ) -> Result<(), AftError> {
         let (d, s, nc, nt) = (self.d, self.s, self.nc, self.nt);
         debug_assert_eq!(u_coeffs.len(), nc * d);
-        // Samples of u and du/dθ per direction (Eq. 15, DFT⁻¹).
+        // Samples of u and, for a law that reads them, du/dθ (Eq. 15, DFT⁻¹). A rate-independent
+        // law never sees its velocity: one inverse transform per direction instead of two.
+        let velocity = law.depends_on_velocity();
         for a in 0..d {
             for c in 0..nc {
                 self.coeff_buf[c] = u_coeffs[c * d + a];
             }
             plan.synthesize(&self.coeff_buf, &mut self.u[a * nt..(a + 1) * nt], &mut self.scratch);
-            plan.synthesize_derivative(&self.coeff_buf, &mut self.dudtheta[a * nt..(a + 1) * nt], &mut self.scratch);
-            for j in 0..nt {
-                self.v[a * nt + j] = omega * self.dudtheta[a * nt + j];
+            if velocity {
+                let dudtheta = &mut self.dudtheta[a * nt..(a + 1) * nt];
+                plan.synthesize_derivative(&self.coeff_buf, dudtheta, &mut self.scratch);
+                for j in 0..nt {
+                    self.v[a * nt + j] = omega * dudtheta[j];
+                }
             }
         }
         let want_jac = jacobian.is_some();
-        let velocity = law.depends_on_velocity();
         let cols = nc * d + 1;
         // Closed-form Jacobian for sliders (module docs); the generic chain rule otherwise.
         let slider = law.slider_stiffness().filter(|_| d == 1 && s == 1 && !velocity);
@@ -192,11 +202,13 @@ impl ElementAft {
         let j0 = known.unwrap_or(0);
         if known.is_none() {
             self.load_sample(0);
-            law.initial_state(&self.u_now, &mut self.state, want_jac.then_some(&mut self.ds0[..]));
+            let ds0 = (want_jac || slider.is_some()).then_some(&mut self.ds0[..]);
+            law.initial_state(&self.u_now, &mut self.state, ds0);
         }
         // The slider's anchor: the sample whose displacement fixes its position (None: at rest
         // at the origin, by the stuck-mean convention).
-        let mut anchor = (slider.is_some() && want_jac && self.ds0[0] != 0.0).then_some(j0);
+        // (For a slider whether or not a Jacobian is asked: it may be completed afterwards.)
+        let mut anchor = (slider.is_some() && self.ds0[0] != 0.0).then_some(j0);
         if chain_rule {
             let e0 = plan.basis_at(j0);
             self.sens.iter_mut().for_each(|v| *v = 0.0);
@@ -223,32 +235,48 @@ impl ElementAft {
             if chain_rule {
                 self.sens_period_start.copy_from_slice(&self.sens);
             }
-            for i in 0..nt {
-                let j = (j0 + i) % nt;
-                self.load_sample(j);
-                self.state_before.copy_from_slice(&self.state);
-                law.update(
-                    &self.u_now,
-                    &self.v_now,
-                    &mut self.state,
-                    &mut self.g_now,
-                    // The closed-form slider Jacobian needs only the slip flags, not the tangent.
-                    if chain_rule { Some(&mut self.tangent) } else { None },
-                );
-                for a in 0..d {
-                    self.g[a * nt + j] = self.g_now[a];
-                }
-                self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
-                if chain_rule {
-                    self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
-                } else if want_jac {
-                    if self.slipping[j] {
-                        anchor = Some(j);
+            if slider.is_some() {
+                // The same steps in three stretches (the first sample alone, for the state
+                // after it), then the anchors from the slip flags.
+                let mut w = self.state[0];
+                for (n, range) in [j0..j0 + 1, j0 + 1..nt, 0..j0].into_iter().enumerate() {
+                    law.update_slider_samples(&self.u, &self.v, range, &mut w, &mut self.g, &mut self.slipping);
+                    if n == 0 {
+                        self.state_after_start[0] = w;
                     }
-                    self.anchor[j] = anchor.unwrap_or(usize::MAX);
                 }
-                if i == 0 {
-                    self.state_after_start.copy_from_slice(&self.state);
+                self.state[0] = w;
+                {
+                    for i in 0..nt {
+                        let j = wrap(j0 + i, nt);
+                        if self.slipping[j] {
+                            anchor = Some(j);
+                        }
+                        self.anchor[j] = anchor.unwrap_or(usize::MAX);
+                    }
+                }
+            } else {
+                for i in 0..nt {
+                    let j = (j0 + i) % nt;
+                    self.load_sample(j);
+                    self.state_before.copy_from_slice(&self.state);
+                    law.update(
+                        &self.u_now,
+                        &self.v_now,
+                        &mut self.state,
+                        &mut self.g_now,
+                        if chain_rule { Some(&mut self.tangent) } else { None },
+                    );
+                    for a in 0..d {
+                        self.g[a * nt + j] = self.g_now[a];
+                    }
+                    self.slipping[j] = law.is_slipping(&self.state_before, &self.state);
+                    if chain_rule {
+                        self.differentiate_sample(j, omega, velocity, plan.basis_at(j), plan.basis_derivative_at(j));
+                    }
+                    if i == 0 {
+                        self.state_after_start.copy_from_slice(&self.state);
+                    }
                 }
             }
             if !hysteretic {
@@ -293,6 +321,7 @@ impl ElementAft {
             }
         }
         self.slider_jacobian_of = None;
+        self.last_slider = slider.map(|k| (k, law.replaced_stiffness(0, 0), j0));
         if let Some((mut jac, dg_domega)) = jacobian {
             if let Some(k) = slider {
                 self.slider_jacobian_of = Some((k, j0));
@@ -313,6 +342,17 @@ impl ElementAft {
             }
         }
         Ok(())
+    }
+
+    /// The Jacobian of the last evaluation, made without one, of a slider: `J = ∂G/∂X` and
+    /// `∂G/∂Ω` (zero) as [`Self::evaluate`] would have written them. False, nothing written,
+    /// if the law was not a slider (its Jacobian needs the march).
+    pub fn complete_slider_jacobian(&mut self, plan: &AftPlan, jac: MatMut<'_, f64>, dg_domega: &mut [f64]) -> bool {
+        let Some((k, k_r, j0)) = self.last_slider else { return false };
+        self.slider_jacobian_of = Some((k, j0));
+        self.slider_jacobian(plan, k, k_r, j0, jac);
+        dg_domega.iter_mut().for_each(|v| *v = 0.0);
+        true
     }
 
     /// Closed-form Jacobian of a slider (module docs) from the stick flags and anchors of the
@@ -345,11 +385,10 @@ impl ElementAft {
             }
         }
         // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order.
-        let p = plan.projection();
         let mut current = usize::MAX;
         self.coeff_buf.iter_mut().for_each(|v| *v = 0.0);
         for i in 0..=nt {
-            let j = (j0 + i) % nt;
+            let j = wrap(j0 + i, nt);
             let a = if i == nt || self.slipping[j] { usize::MAX } else { self.anchor[j] };
             if a != current {
                 if current != usize::MAX {
@@ -365,8 +404,8 @@ impl ElementAft {
                 current = a;
             }
             if current != usize::MAX {
-                for c in 0..nc {
-                    self.coeff_buf[c] += p[(c, j)];
+                for (b, pc) in self.coeff_buf.iter_mut().zip(plan.projection_at(j)) {
+                    *b += pc;
                 }
             }
         }
@@ -508,6 +547,16 @@ impl ElementAft {
             }
         }
         std::mem::swap(&mut self.sens, &mut self.sens_next);
+    }
+}
+
+/// `j mod n_t` for `j < 2 n_t`: a sample index in marching order, without a division.
+#[inline]
+fn wrap(j: usize, nt: usize) -> usize {
+    if j >= nt {
+        j - nt
+    } else {
+        j
     }
 }
 

@@ -151,6 +151,11 @@ impl AftPlan {
         self.basis_derivative_at_sample.col_as_slice(j)
     }
 
+    /// The weights of sample `j` in every coefficient: column j of `P`, contiguous.
+    pub fn projection_at(&self, j: usize) -> &[f64] {
+        self.projection.col_as_slice(j)
+    }
+
     /// Projection matrix `P` (`(2N+1) × n_t`): `X_c = Σ_j P[(c,j)] x_j`.
     pub fn projection(&self) -> &Mat<f64> {
         &self.projection

@@ -83,6 +83,25 @@ impl JointForces {
         Ok(())
     }
 
+    /// Each element's block of `∂G/∂x` and `∂G/∂Ω` at the last evaluation, made without them,
+    /// when every element is a slider ([`ElementAft::complete_slider_jacobian`]); false if one
+    /// is not.
+    pub fn complete_jacobian(&mut self, model: &NonlinearModel, plan: &AftPlan) -> bool {
+        let (q, nc) = (self.q, plan.n_coeffs());
+        for (e, site) in model.elements.iter().enumerate() {
+            if !self.afts[e].complete_slider_jacobian(plan, self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e]) {
+                return false;
+            }
+            let (d, off) = (site.law.n_dirs(), self.offsets[e]);
+            for c in 0..nc {
+                for a in 0..d {
+                    self.dg_domega[c * q + off + a] = self.elem_dgdw[e][c * d + a];
+                }
+            }
+        }
+        true
+    }
+
     /// `∂G/∂x` assembled (q(2N+1) square) from the last evaluation with `want`, each element's
     /// block made complex and passed to `block` first (which may change it, e.g. to weight a
     /// slider's memory for a perturbation `e^{st}`).

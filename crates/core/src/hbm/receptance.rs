@@ -44,7 +44,21 @@ pub struct ModalReceptance {
     /// `b = Φᵀ F` (m).
     b: Vec<f64>,
     modes: Modes,
+    /// The same data laid out for loops over the modes, which are the long dimension (q is a
+    /// few directions, m every mode of the model): `ω_r²`, the rows of `A` (`rows[i·m + r]`),
+    /// the rows of `A diag(b)` (`u_F`'s weights), and for few directions
+    /// ([`PAIRWISE_UP_TO`]) the products `a_ir a_jr` of each pair j ≤ i (`pairs[p·m + r]`),
+    /// so that an entry of `H` is one dot product with the modal weights.
+    omega_r2: Vec<f64>,
+    rows: Vec<f64>,
+    force_rows: Vec<f64>,
+    pairs: Vec<f64>,
 }
+
+/// Number of directions up to which `H` is summed pair by pair from precomputed products
+/// (q(q+1)/2 dot products of length m: no temporaries, no call overhead); above it, two
+/// triangular matrix products, which block for the cache.
+const PAIRWISE_UP_TO: usize = 16;
 
 #[derive(Debug)]
 pub struct DirectReceptance {
@@ -69,9 +83,12 @@ pub struct HarmonicReceptance {
     /// `u_F` (q).
     pub u_force: Vec<c64>,
     pub du_force: Vec<c64>,
-    /// Modal: `1/den_r` and `d(1/den_r)/dω` of every mode.
-    inverse: Vec<c64>,
-    inverse_derivative: Vec<c64>,
+    /// Modal: `1/den_r` and `d(1/den_r)/dω` of every mode, real and imaginary parts apart
+    /// (the loops over modes vectorise).
+    inverse: [Vec<f64>; 2],
+    inverse_derivative: [Vec<f64>; 2],
+    /// Modal: a product `Aᵀ g` (m, complex as two parts), reused.
+    projected: [Vec<f64>; 2],
     /// Modal: `A diag(Re 1/den)` and `A diag(Im 1/den)` (q × m), and the real and imaginary
     /// parts of `H` (lower triangles), reused from call to call.
     scaled: [Mat<f64>; 2],
@@ -87,8 +104,9 @@ impl HarmonicReceptance {
             h: Mat::zeros(q, q),
             u_force: vec![c64::new(0.0, 0.0); q],
             du_force: vec![c64::new(0.0, 0.0); q],
-            inverse: Vec::new(),
-            inverse_derivative: Vec::new(),
+            inverse: [Vec::new(), Vec::new()],
+            inverse_derivative: [Vec::new(), Vec::new()],
+            projected: [Vec::new(), Vec::new()],
             scaled: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
             parts: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
             dh: Mat::zeros(0, 0),
@@ -110,7 +128,28 @@ impl Receptance {
             let b: Vec<f64> = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
             let c_r =
                 modes.omega.iter().enumerate().map(|(r, &w)| model.damping.modal_coefficient(r, w).unwrap()).collect();
-            Ok(Receptance::Modal(ModalReceptance { omega_r: modes.omega.clone(), c_r, a, b, modes }))
+            let omega_r2 = modes.omega.iter().map(|w| w * w).collect();
+            let rows = (0..q).flat_map(|i| (0..m).map(move |r| (i, r))).map(|(i, r)| a[(i, r)]).collect();
+            let force_rows = (0..q).flat_map(|i| (0..m).map(move |r| (i, r))).map(|(i, r)| a[(i, r)] * b[r]).collect();
+            let pairs = if q <= PAIRWISE_UP_TO {
+                lower_pairs(q)
+                    .flat_map(|(i, j)| (0..m).map(move |r| (i, j, r)))
+                    .map(|(i, j, r)| a[(i, r)] * a[(j, r)])
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            Ok(Receptance::Modal(ModalReceptance {
+                omega_r: modes.omega.clone(),
+                c_r,
+                a,
+                b,
+                modes,
+                omega_r2,
+                rows,
+                force_rows,
+                pairs,
+            }))
         } else {
             // Check M > 0 and K > 0 the same way as the modal path, so both fail alike.
             model.dense_modes()?;
@@ -137,7 +176,7 @@ impl Receptance {
     /// into `out` (the matrix `H` is left as it was).
     pub fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance) {
         match self {
-            Receptance::Modal(m) => m.evaluate(omega, out, false),
+            Receptance::Modal(m) => m.evaluate(omega, out, true, false),
             Receptance::Direct(d) => d.evaluate(omega, out),
         }
     }
@@ -145,23 +184,48 @@ impl Receptance {
     /// [`Self::evaluate`] and the matrix `H(ω)` (q × q) into `out.h`.
     pub fn evaluate_matrix(&self, omega: f64, out: &mut HarmonicReceptance) {
         match self {
-            Receptance::Modal(m) => m.evaluate(omega, out, true),
+            Receptance::Modal(m) => m.evaluate(omega, out, true, true),
+            Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
+    /// [`Self::evaluate`] (with `matrix`, [`Self::evaluate_matrix`]) for a harmonic the
+    /// excitation does not reach: `u_F` and its derivative may be left as they were.
+    pub fn evaluate_unforced(&self, omega: f64, out: &mut HarmonicReceptance, matrix: bool) {
+        match self {
+            Receptance::Modal(m) => m.evaluate(omega, out, false, matrix),
+            Receptance::Direct(d) => d.evaluate(omega, out),
+        }
+    }
+
+    /// The matrix `H(ω)` into `out`, after an evaluation at ω without it: what
+    /// [`Self::evaluate_matrix`] adds to [`Self::evaluate`], from the modal weights already
+    /// there (the same values).
+    pub fn complete_matrix(&self, omega: f64, out: &mut HarmonicReceptance) {
+        match self {
+            Receptance::Modal(m) => m.matrix(out),
             Receptance::Direct(d) => d.evaluate(omega, out),
         }
     }
 
     /// `H(ω) g` for complex force amplitudes `g` (q), with `hr` from an evaluation at ω.
-    pub fn apply(&self, hr: &HarmonicReceptance, g: &[c64], out: &mut [c64]) {
+    pub fn apply(&self, hr: &mut HarmonicReceptance, g: &[c64], out: &mut [c64]) {
         match self {
-            Receptance::Modal(m) => m.apply(&hr.inverse, g, out),
+            Receptance::Modal(m) => {
+                let HarmonicReceptance { inverse, projected, .. } = hr;
+                m.apply(inverse, projected, g, out)
+            }
             Receptance::Direct(_) => multiply(&hr.h, g, out),
         }
     }
 
     /// `dH/dω (ω) g`, with `hr` from an evaluation at ω.
-    pub fn apply_derivative(&self, hr: &HarmonicReceptance, g: &[c64], out: &mut [c64]) {
+    pub fn apply_derivative(&self, hr: &mut HarmonicReceptance, g: &[c64], out: &mut [c64]) {
         match self {
-            Receptance::Modal(m) => m.apply(&hr.inverse_derivative, g, out),
+            Receptance::Modal(m) => {
+                let HarmonicReceptance { inverse_derivative, projected, .. } = hr;
+                m.apply(inverse_derivative, projected, g, out)
+            }
             Receptance::Direct(_) => multiply(&hr.dh, g, out),
         }
     }
@@ -172,8 +236,9 @@ impl Receptance {
         match self {
             Receptance::Modal(m) => {
                 let (q, a) = (m.a.nrows(), &m.a);
+                let [re, im] = &hr.inverse_derivative;
                 Mat::from_fn(q, q, |i, j| {
-                    (0..m.omega_r.len()).map(|r| hr.inverse_derivative[r] * (a[(i, r)] * a[(j, r)])).sum()
+                    (0..m.omega_r.len()).map(|r| c64::new(re[r], im[r]) * (a[(i, r)] * a[(j, r)])).sum()
                 })
             }
             Receptance::Direct(_) => hr.dh.clone(),
@@ -232,31 +297,49 @@ impl ModalReceptance {
         &self.modes
     }
 
-    /// The modal weights `1/den_r` and their ω-derivatives, `u_F` (O(q m)) and, with `matrix`,
-    /// `H = A diag(1/den) Aᵀ`: two real symmetric products (lower triangles), O(q² m) on a
-    /// q × m participation matrix that stays in cache.
-    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance, matrix: bool) {
+    /// The modal weights `1/den_r` and their ω-derivatives, with `force` `u_F` and its
+    /// derivative (O(q m)) and, with `matrix`, `H = A diag(1/den) Aᵀ` (O(q² m)): loops over the
+    /// modes on contiguous rows, or for many directions two real symmetric products (lower
+    /// triangles) on a q × m participation matrix that stays in cache.
+    fn evaluate(&self, omega: f64, out: &mut HarmonicReceptance, force: bool, matrix: bool) {
         let (q, m) = (self.a.nrows(), self.omega_r.len());
-        out.inverse.resize(m, c64::new(0.0, 0.0));
-        out.inverse_derivative.resize(m, c64::new(0.0, 0.0));
+        for part in out.inverse.iter_mut().chain(&mut out.inverse_derivative).chain(&mut out.projected) {
+            part.resize(m, 0.0);
+        }
+        let [inv_re, inv_im] = &mut out.inverse;
+        let [dinv_re, dinv_im] = &mut out.inverse_derivative;
         for r in 0..m {
-            let den = c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * self.c_r[r]);
+            let den = c64::new(self.omega_r2[r] - omega * omega, omega * self.c_r[r]);
             let inv = den.inv();
-            out.inverse[r] = inv;
             // d(1/den)/dω = −(−2ω + i c_r)/den² = (2ω − i c_r)/den².
-            out.inverse_derivative[r] = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
+            let dinv = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
+            (inv_re[r], inv_im[r], dinv_re[r], dinv_im[r]) = (inv.re, inv.im, dinv.re, dinv.im);
         }
-        for i in 0..q {
-            let (mut u, mut du) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
-            for r in 0..m {
-                let ab = self.a[(i, r)] * self.b[r];
-                u += out.inverse[r] * ab;
-                du += out.inverse_derivative[r] * ab;
+        if force {
+            for i in 0..q {
+                let row = &self.force_rows[i * m..(i + 1) * m];
+                let (re, im) = dot2(row, inv_re, inv_im);
+                out.u_force[i] = c64::new(re, im);
+                let (re, im) = dot2(row, dinv_re, dinv_im);
+                out.du_force[i] = c64::new(re, im);
             }
-            out.u_force[i] = u;
-            out.du_force[i] = du;
         }
-        if !matrix {
+        if matrix {
+            self.matrix(out);
+        }
+    }
+
+    /// `H = A diag(1/den) Aᵀ` into `out.h` from the weights `out` holds.
+    fn matrix(&self, out: &mut HarmonicReceptance) {
+        let (q, m) = (self.a.nrows(), self.omega_r.len());
+        let [inv_re, inv_im] = &out.inverse;
+        if q <= PAIRWISE_UP_TO {
+            for (p, (i, j)) in lower_pairs(q).enumerate() {
+                let (re, im) = dot2(&self.pairs[p * m..(p + 1) * m], inv_re, inv_im);
+                let v = c64::new(re, im);
+                out.h[(i, j)] = v;
+                out.h[(j, i)] = v;
+            }
             return;
         }
         if out.scaled[0].nrows() != q || out.scaled[0].ncols() != m {
@@ -265,10 +348,10 @@ impl ModalReceptance {
         }
         for part in 0..2 {
             let scaled = &mut out.scaled[part];
+            let w = &out.inverse[part];
             for r in 0..m {
-                let w = if part == 0 { out.inverse[r].re } else { out.inverse[r].im };
                 for i in 0..q {
-                    scaled[(i, r)] = self.a[(i, r)] * w;
+                    scaled[(i, r)] = self.a[(i, r)] * w[r];
                 }
             }
             triangular::matmul(
@@ -293,19 +376,26 @@ impl ModalReceptance {
         }
     }
 
-    /// `A diag(weights) Aᵀ g`: a receptance-like product in O(q m).
-    fn apply(&self, weights: &[c64], g: &[c64], out: &mut [c64]) {
-        let (q, m) = (self.a.nrows(), self.omega_r.len());
-        out.iter_mut().for_each(|v| *v = c64::new(0.0, 0.0));
+    /// `A diag(weights) Aᵀ g`, a receptance-like product in O(q m): `Aᵀ g` into `projected`,
+    /// weighted, then one dot product per direction.
+    fn apply(&self, weights: &[Vec<f64>; 2], projected: &mut [Vec<f64>; 2], g: &[c64], out: &mut [c64]) {
+        let m = self.omega_r.len();
+        let [t_re, t_im] = projected;
+        t_re.iter_mut().chain(t_im.iter_mut()).for_each(|v| *v = 0.0);
+        for (row, gj) in self.rows.chunks_exact(m).zip(g) {
+            for ((a, re), im) in row.iter().zip(t_re.iter_mut()).zip(t_im.iter_mut()) {
+                *re += a * gj.re;
+                *im += a * gj.im;
+            }
+        }
+        let [w_re, w_im] = weights;
         for r in 0..m {
-            let mut t = c64::new(0.0, 0.0);
-            for j in 0..q {
-                t += g[j] * self.a[(j, r)];
-            }
-            let t = t * weights[r];
-            for i in 0..q {
-                out[i] += t * self.a[(i, r)];
-            }
+            let t = c64::new(t_re[r], t_im[r]) * c64::new(w_re[r], w_im[r]);
+            (t_re[r], t_im[r]) = (t.re, t.im);
+        }
+        for (row, o) in self.rows.chunks_exact(m).zip(out.iter_mut()) {
+            let (re, im) = dot2(row, t_re, t_im);
+            *o = c64::new(re, im);
         }
     }
 
@@ -389,6 +479,32 @@ impl DirectReceptance {
         }
         (amps, dissipation)
     }
+}
+
+/// The pairs (i, j), j ≤ i, of q directions: the lower triangle column by column.
+fn lower_pairs(q: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..q).flat_map(move |j| (j..q).map(move |i| (i, j)))
+}
+
+/// `(Σ a x, Σ a y)`: two dot products sharing `a`, on four independent partial sums each so
+/// that the loop vectorises (the order of a floating-point sum is otherwise fixed).
+#[inline]
+fn dot2(a: &[f64], x: &[f64], y: &[f64]) -> (f64, f64) {
+    let (mut sx, mut sy) = ([0.0; 4], [0.0; 4]);
+    let (ca, cx, cy) = (a.chunks_exact(4), x.chunks_exact(4), y.chunks_exact(4));
+    let (ra, rx, ry) = (ca.remainder(), cx.remainder(), cy.remainder());
+    for ((a, x), y) in ca.zip(cx).zip(cy) {
+        for l in 0..4 {
+            sx[l] += a[l] * x[l];
+            sy[l] += a[l] * y[l];
+        }
+    }
+    let (mut tx, mut ty) = ((sx[0] + sx[1]) + (sx[2] + sx[3]), (sy[0] + sy[1]) + (sy[2] + sy[3]));
+    for ((a, x), y) in ra.iter().zip(rx).zip(ry) {
+        tx += a * x;
+        ty += a * y;
+    }
+    (tx, ty)
 }
 
 /// `h g` for a dense complex matrix.

@@ -50,6 +50,18 @@ impl Problem for FrequencySweep<'_, '_> {
         self.hbm.evaluate(x, omega, self.level, residual, jac).map_err(problem_error)
     }
 
+    fn completes_jacobian(&self) -> bool {
+        self.hbm.completes_jacobian()
+    }
+
+    fn complete_jacobian(&mut self, (dx, dl): (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
+        if self.hbm.complete_jacobian(dx, Some(dl), None) {
+            Ok(())
+        } else {
+            Err(ProblemError::new("no residual evaluation of sliders to complete to a Jacobian"))
+        }
+    }
+
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
         if self.hbm.factors_by_structure() {
             Some(self)
@@ -89,6 +101,18 @@ impl Problem for LevelSweep<'_, '_> {
     ) -> Result<(), ProblemError> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: None, dlevel: Some(dl) });
         self.hbm.evaluate(x, self.omega, level, residual, jac).map_err(problem_error)
+    }
+
+    fn completes_jacobian(&self) -> bool {
+        self.hbm.completes_jacobian()
+    }
+
+    fn complete_jacobian(&mut self, (dx, dl): (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
+        if self.hbm.complete_jacobian(dx, None, Some(dl)) {
+            Ok(())
+        } else {
+            Err(ProblemError::new("no residual evaluation of sliders to complete to a Jacobian"))
+        }
     }
 
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {

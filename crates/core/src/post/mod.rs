@@ -174,8 +174,16 @@ pub fn evaluate_point(
                     .collect()
             })
             .collect();
-        let slider_velocity =
-            (0..d).map(|a| (0..nt).map(|j| if aft.slipping[j] { aft.v[a * nt + j] } else { 0.0 }).collect()).collect();
+        // The velocity samples as the AFT computes them, Ω du/dθ (it skips them for the
+        // rate-independent laws, whose update never reads them).
+        let mut rate = vec![0.0; nt];
+        let slider_velocity = (0..d)
+            .map(|a| {
+                let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
+                plan.synthesize_derivative(&coeffs, &mut rate, &mut scratch);
+                (0..nt).map(|j| if aft.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
+            })
+            .collect();
         let stuck = aft.slipping.iter().filter(|s| !**s).count();
         element_results.push(ElementResult {
             name: site.name.clone(),
