@@ -197,8 +197,9 @@ fn main() {
     if wanted("stability") {
         // Hill's method on every point of a paper-size sweep (2910 N, where the joints slip):
         // the sweep alone; the stability of each point computed in full, by the reference (the
-        // sliders' memory refined by a complex eigenproblem per fixed-point step) on 20 of
-        // them and as a run does it (Newton's refinement) on all.
+        // sliders' memory refined by a complex eigenproblem per fixed-point step, Hill's matrix
+        // whole) on 20 of them and as a run does it (split into even and odd harmonics, Newton's
+        // refinement) on all.
         let paper = chain_with_joints(137, 4, false);
         let mut force = vec![0.0; 137];
         force[136] = 1.0;
@@ -215,10 +216,11 @@ fn main() {
         let sweep_seconds = median(sweeps);
         let n = branch.points.len();
         let hill = Hill::new(hbm.receptance(), HillSettings::for_band(7, TWO_PI * 300.0)).unwrap();
+        let whole = hill.clone().without_symmetry();
         let mut reference = Vec::new();
         for p in branch.points.iter().step_by((n / 20).max(1)) {
             let start = Instant::now();
-            std::hint::black_box(stability_by_eigenproblems(&mut hbm, &hill, &p.x, p.lambda).unwrap());
+            std::hint::black_box(stability_by_eigenproblems(&mut hbm, &whole, &p.x, p.lambda).unwrap());
             reference.push(start.elapsed().as_secs_f64());
         }
         let mut full = Vec::new();
@@ -231,7 +233,7 @@ fn main() {
             full_total += full.last().unwrap();
             unstable += usize::from(!s.is_stable(1e-9 * p.lambda));
         }
-        let (mut jacobian, mut spectrum) = (Vec::new(), Vec::new());
+        let (mut jacobian, mut spectrum, mut whole_spectrum) = (Vec::new(), Vec::new(), Vec::new());
         for p in &branch.points {
             let start = Instant::now();
             let jac = hbm.element_force_jacobian(&p.x, p.lambda).unwrap();
@@ -239,9 +241,12 @@ fn main() {
             let start = Instant::now();
             std::hint::black_box(hill.exponents(p.lambda, jac.as_ref()).unwrap());
             spectrum.push(start.elapsed().as_secs_f64());
+            let start = Instant::now();
+            std::hint::black_box(whole.exponents(p.lambda, jac.as_ref()).unwrap());
+            whole_spectrum.push(start.elapsed().as_secs_f64());
         }
-        let (reference, full, jacobian, spectrum) =
-            (median(reference), median(full), median(jacobian), median(spectrum));
+        let (reference, full, jacobian) = (median(reference), median(full), median(jacobian));
+        let (spectrum, whole_spectrum) = (median(spectrum), median(whole_spectrum));
         let total: f64 = full_total;
         println!(
             "137 DOFs, q = 4, 2910 N: sweep {:.1} ms for {n} points ({:.3} ms/point), {} modes kept, {unstable} points unstable",
@@ -251,11 +256,12 @@ fn main() {
         );
         println!(
             "  stability per point: reference {:.2} ms, now {:.2} ms (of which the joints' Jacobian {:.3} ms, \
-             the periodic spectrum {:.2} ms)",
+             the periodic spectrum {:.2} ms, {:.2} ms unsplit)",
             reference * 1e3,
             full * 1e3,
             jacobian * 1e3,
-            spectrum * 1e3
+            spectrum * 1e3,
+            whole_spectrum * 1e3
         );
         println!(
             "  stability of the {n} points: {:.1} ms, {:.0} % of the sweep",
