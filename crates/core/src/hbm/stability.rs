@@ -369,7 +369,7 @@ impl Hill {
             if depends_on_s || k_nl.is_none() {
                 let jac = jacobian(s);
                 let nq = jac.nrows();
-                if nq % q != 0 || jac.ncols() != nq || nq == 0 {
+                if !nq.is_multiple_of(q) || jac.ncols() != nq || nq == 0 {
                     return Err(StabilityError::JacobianSize { got: nq, expected: q });
                 }
                 k_nl = Some(self.joint_stiffness(jac.as_ref()));
