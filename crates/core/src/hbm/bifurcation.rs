@@ -78,10 +78,10 @@ pub const EXPONENT_TOLERANCE: f64 = 1e-9;
 /// also sorts out the physical exponents) start Newton's method on the nonlinear Hill problem
 /// `T(s) P = 0` for the leading ones ([`Hill::refine`]: one complex LU of size m(2N+1) per
 /// step). The fixed point `s ← the eigenvalue of Hill(J(s)) nearest s` that it replaces (a
-/// complex eigenproblem of size 2m(2N+1) per step, ~25 LUs' worth) remains where two exponents
-/// nearly coincide ([`CLOSE_ROOT`]): there the nonlinear problem has several roots close
-/// together, and the fixed point's "nearest eigenvalue" rule picks which; Newton might settle
-/// on another. [`stability_by_eigenproblems`] is the fixed point everywhere, the reference.
+/// complex eigenproblem of size 2m(2N+1) per step, tens of LUs' worth) remains where Newton's
+/// root lies far from its start ([`CLOSE_ROOT`]): there the nonlinear problem has several
+/// roots, and the fixed point's "nearest eigenvalue" rule picks which; Newton might settle on
+/// another. [`stability_by_eigenproblems`] is the fixed point everywhere, the reference.
 pub fn stability_at(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
@@ -173,14 +173,17 @@ fn fixed_point(hbm: &CondensedHbm<'_>, hill: &Hill, omega: f64, start: c64) -> R
 const REFINED: usize = 2;
 const MEMORY_ITERATIONS: usize = 50;
 
-/// Newton's root is taken for the exponent's only within this fraction of the distance from
-/// its start to the nearest other exponent; beyond, the fixed point decides (see
-/// [`stability_at`]). The memory moves an exponent by a few per cent of its real part (4 % and
-/// 7 % on Table 6), so a root further away is another root of the nonlinear problem (e^{−sΔ}
-/// gives it infinitely many) or one of two that a coalescing pair offers: on Table 6 at 3000 N
-/// near 189 Hz, a complex pair 3.8 1/s from its conjugate, Newton settled 1.4 1/s away on a
-/// complex root where the fixed point finds a real one; elsewhere Newton's roots lie within
-/// 0.15 of that distance and equal the fixed point's (the test `stability_newton`).
+/// Newton's root is taken for the exponent only within this fraction of the distance from its
+/// start to the nearest other exponent; beyond, the fixed point decides (see [`stability_at`]).
+/// The memory moves a leading exponent by a few per cent of its real part (4 % and 7 % on
+/// Table 6), so a root further away is likely another root of the nonlinear problem (e^{−sΔ}
+/// gives it infinitely many) or the other of two that a coalescing pair offers: on Table 6 at
+/// 3000 N near 189 Hz, a complex pair 3.8 1/s from its conjugate, Newton settled 1.4 1/s away on
+/// a complex root where the fixed point finds a real one. The strongly damped real exponent of a
+/// stuck slider moves much further (Table 6 at 100 N: −358 to −644 1/s by the fixed point), where
+/// Newton from the periodic start fails or lands on another root (the leading exponent's, or
+/// −2.8e4 1/s): the fixed point's result is kept there too. The test `stability_newton` checks
+/// the outcome against the fixed point everywhere.
 pub const CLOSE_ROOT: f64 = 0.25;
 
 /// Is the solution with these exponents stable at Ω?
