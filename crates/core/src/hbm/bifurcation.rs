@@ -74,14 +74,40 @@ pub const EXPONENT_TOLERANCE: f64 = 1e-9;
 /// With sliders (Jenkins joints), Hill's matrix depends on the exponent itself: a stuck
 /// slider remembers the displacement at its last slip, a delay Δ back, which a perturbation
 /// `e^{st}` weights by `e^{−sΔ}` ([`super::ElementAft::add_memory_delay`]). The exponents of the
-/// periodic Jacobian (s = 0 in the weights) start a fixed-point iteration
-/// `s ← the eigenvalue of Hill(J(s)) nearest s` for the leading ones, which converges fast
-/// (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
+/// periodic Jacobian (s = 0 in the weights; one real eigenproblem on the companion form, which
+/// also sorts out the physical exponents) start Newton's method on the nonlinear Hill problem
+/// `T(s) P = 0` for the leading ones ([`Hill::refine`]: one complex LU of size m(2N+1) per
+/// step). The fixed point `s ← the eigenvalue of Hill(J(s)) nearest s` that it replaces (a
+/// complex eigenproblem of size 2m(2N+1) per step, tens of LUs' worth) remains where Newton's
+/// root lies far from its start ([`CLOSE_ROOT`]): there the nonlinear problem has several
+/// roots, and the fixed point's "nearest eigenvalue" rule picks which; Newton might settle on
+/// another. [`stability_by_eigenproblems`] is the fixed point everywhere, the reference.
 pub fn stability_at(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
     x: &[f64],
     omega: f64,
+) -> Result<Stability, BranchStabilityError> {
+    refined_stability(hbm, hill, x, omega, false)
+}
+
+/// [`stability_at`] with the sliders' memory refined by the fixed point of dense eigenproblems
+/// everywhere: the reference the faster [`stability_at`] is tested against.
+pub fn stability_by_eigenproblems(
+    hbm: &mut CondensedHbm<'_>,
+    hill: &Hill,
+    x: &[f64],
+    omega: f64,
+) -> Result<Stability, BranchStabilityError> {
+    refined_stability(hbm, hill, x, omega, true)
+}
+
+fn refined_stability(
+    hbm: &mut CondensedHbm<'_>,
+    hill: &Hill,
+    x: &[f64],
+    omega: f64,
+    reference: bool,
 ) -> Result<Stability, BranchStabilityError> {
     let jacobian = hbm.element_force_jacobian(x, omega)?;
     let mut stability = hill.exponents(omega, jacobian.as_ref())?;
@@ -90,32 +116,27 @@ pub fn stability_at(
     }
     let leading: Vec<usize> =
         (0..stability.exponents.len()).filter(|&i| stability.exponents[i].im >= 0.0).take(REFINED).collect();
+    let periodic = stability.exponents.clone();
     for i in leading {
-        let start = stability.exponents[i];
-        let mut s = start;
-        let mut previous_change = f64::INFINITY;
-        for _ in 0..MEMORY_ITERATIONS {
-            let jac = hbm.delayed_force_jacobian(omega, s);
-            let all = hill.eigenvalues(omega, jac.as_ref())?;
-            let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
-            let change = (next - s).norm();
-            s = next;
-            // Converged, or down to the eigensolver's round-off (~1e-10 of the matrix's
-            // scale): the change stops decreasing.
-            if change <= 1e-10 * omega || change >= previous_change {
-                break;
-            }
-            previous_change = change;
-        }
+        let start = periodic[i];
+        let nearest = (0..periodic.len()).filter(|&j| j != i).map(|j| (periodic[j] - start).norm());
+        let nearest = nearest.fold(f64::INFINITY, f64::min);
+        let newton = match reference {
+            true => None,
+            false => hill
+                .refine(omega, start, None, true, MEMORY_ITERATIONS, |s| hbm.delayed_force_jacobian(omega, s))?
+                .map(|r| r.exponent)
+                .filter(|s| (s - start).norm() <= CLOSE_ROOT * nearest.min(omega)),
+        };
+        let s = match newton {
+            Some(s) => s,
+            None => fixed_point(hbm, hill, omega, start)?,
+        };
         // Its conjugate (the same perturbation, real) follows.
-        if let Some(j) = (0..stability.exponents.len())
+        if let Some(j) = (0..periodic.len())
             .filter(|&j| j != i)
-            .min_by(|&a, &b| {
-                (stability.exponents[a] - start.conj())
-                    .norm()
-                    .total_cmp(&(stability.exponents[b] - start.conj()).norm())
-            })
-            .filter(|&j| start.im > 0.0 && (stability.exponents[j] - start.conj()).norm() <= 1e-9 * omega)
+            .min_by(|&a, &b| (periodic[a] - start.conj()).norm().total_cmp(&(periodic[b] - start.conj()).norm()))
+            .filter(|&j| start.im > 0.0 && (periodic[j] - start.conj()).norm() <= 1e-9 * omega)
         {
             stability.exponents[j] = s.conj();
         }
@@ -125,10 +146,45 @@ pub fn stability_at(
     Ok(stability)
 }
 
+/// The exponent near `start` with the sliders' memory, by the fixed point
+/// `s ← the eigenvalue of Hill(J(s)) nearest s`, one dense complex eigenproblem a step. It
+/// converges fast (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
+fn fixed_point(hbm: &CondensedHbm<'_>, hill: &Hill, omega: f64, start: c64) -> Result<c64, BranchStabilityError> {
+    let mut s = start;
+    let mut previous_change = f64::INFINITY;
+    for _ in 0..MEMORY_ITERATIONS {
+        let jac = hbm.delayed_force_jacobian(omega, s);
+        let all = hill.eigenvalues(omega, jac.as_ref())?;
+        let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
+        let change = (next - s).norm();
+        s = next;
+        // Converged, or down to the eigensolver's round-off (~1e-10 of the matrix's
+        // scale): the change stops decreasing.
+        if change <= 1e-10 * omega || change >= previous_change {
+            break;
+        }
+        previous_change = change;
+    }
+    Ok(s)
+}
+
 /// Exponents refined for the sliders' memory (the leading ones, one per conjugate pair) and the
-/// fixed-point iterations allowed each.
+/// iterations allowed each.
 const REFINED: usize = 2;
 const MEMORY_ITERATIONS: usize = 50;
+
+/// Newton's root is taken for the exponent only within this fraction of the distance from its
+/// start to the nearest other exponent; beyond, the fixed point decides (see [`stability_at`]).
+/// The memory moves a leading exponent by a few per cent of its real part (4 % and 7 % on
+/// Table 6), so a root further away is likely another root of the nonlinear problem (e^{−sΔ}
+/// gives it infinitely many) or the other of two that a coalescing pair offers: on Table 6 at
+/// 3000 N near 189 Hz, a complex pair 3.8 1/s from its conjugate, Newton settled 1.4 1/s away on
+/// a complex root where the fixed point finds a real one. The strongly damped real exponent of a
+/// stuck slider moves much further (Table 6 at 100 N: −358 to −644 1/s by the fixed point), where
+/// Newton from the periodic start fails or lands on another root (the leading exponent's, or
+/// −2.8e4 1/s): the fixed point's result is kept there too. The test `stability_newton` checks
+/// the outcome against the fixed point everywhere.
+pub const CLOSE_ROOT: f64 = 0.25;
 
 /// Is the solution with these exponents stable at Ω?
 pub fn is_stable(stability: &Stability, omega: f64) -> bool {

@@ -438,22 +438,40 @@ impl ElementAft {
         let (nc, nt) = (self.nc, self.nt);
         let dt = 2.0 * std::f64::consts::PI / (omega * nt as f64);
         let p = plan.projection();
+        // The samples of one stick phase share their anchor: Σ_j w_j P_j summed over the phase
+        // first, then one outer product with E_a per phase (nc per sample and nc² per phase,
+        // instead of nc² per sample: Hill's refinement calls this at every step).
+        let mut sum = vec![c64::new(0.0, 0.0); nc];
+        let mut current = usize::MAX;
+        let flush = |sum: &mut [c64], a: usize, jac: &mut Mat<c64>| {
+            if a == usize::MAX {
+                return;
+            }
+            let e_a = plan.basis_at(a);
+            for c in 0..nc {
+                for c2 in 0..nc {
+                    jac[(c, c2)] += sum[c] * e_a[c2];
+                }
+            }
+            sum.fill(c64::new(0.0, 0.0));
+        };
         for i in 0..nt {
             let j = (j0 + i) % nt;
             let a = self.anchor[j];
             if self.slipping[j] || a == usize::MAX {
                 continue;
             }
+            if a != current {
+                flush(&mut sum, current, jac);
+                current = a;
+            }
             let delay = ((j + nt - a) % nt) as f64 * dt;
             let weight = (c64::new(1.0, 0.0) - (-s * delay).exp()) * k;
-            let e_a = plan.basis_at(a);
             for c in 0..nc {
-                let pc = weight * p[(c, j)];
-                for c2 in 0..nc {
-                    jac[(c, c2)] += pc * e_a[c2];
-                }
+                sum[c] += weight * p[(c, j)];
             }
         }
+        flush(&mut sum, current, jac);
         true
     }
 

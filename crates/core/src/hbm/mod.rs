@@ -12,7 +12,9 @@ pub mod stability;
 pub mod structured;
 pub mod sweep;
 
-pub use bifurcation::{bifurcations, stability_at, Bifurcation, BifurcationKind, BranchStabilityError};
+pub use bifurcation::{
+    bifurcations, stability_at, stability_by_eigenproblems, Bifurcation, BifurcationKind, BranchStabilityError,
+};
 pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
@@ -21,5 +23,5 @@ pub use nonlinear_mode::{
     nonlinear_mode, Backbone, BackbonePoint, NegativeDamping, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
 };
 pub use receptance::Receptance;
-pub use stability::{Hill, HillSettings, Stability, StabilityError};
+pub use stability::{Hill, HillSettings, Refined, Stability, StabilityError};
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};
