@@ -53,6 +53,10 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
+    // Notes of the solvers (the factor's size before factorising) go with the stage timings.
+    if !matches!(&cli.command, Command::Run(a) if a.quiet) {
+        stickslip_fe::memory::set_notes(|text| eprintln!("{text}"));
+    }
     let result = match cli.command {
         Command::Run(a) => commands::run::main(a),
         Command::Nlmode(a) => commands::nlmode::main(a),

@@ -3,8 +3,10 @@
 use std::time::Instant;
 
 use faer::prelude::Solve;
+use faer::reborrow::Reborrow;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Mat, Side};
+use rayon::prelude::*;
 use stickslip_core::model::{symmetric_eigen, LinearModel, Matrix};
 
 use super::{reduced_model, Method, Reduction, ReductionError, ReductionOptions, Release};
@@ -98,9 +100,23 @@ fn constraint_modes_from_full(part: &Partition, n: usize, k: &ShiftedFactor) -> 
     k.solve_in_place(g.as_mut());
     let grr = Mat::<f64>::from_fn(nr, nr, |a, b| 0.5 * (g[(part.retained[a], b)] + g[(part.retained[b], a)]));
     let llt = grr.llt(Side::Lower).ok()?;
-    // Ψ = G G_rr⁻¹, i.e. Ψᵀ = G_rr⁻¹ Gᵀ (G_rr symmetric).
-    let psi_t = llt.solve(g.transpose());
-    let mut psi = psi_t.transpose().to_owned();
+    // Ψ = G G_rr⁻¹, i.e. Ψᵀ = G_rr⁻¹ Gᵀ (G_rr symmetric), in place by blocks of rows of G: no
+    // second and third n × r block (250 MB each at 306k DOFs and 103 retained DOFs) while the
+    // factor of K is held.
+    let mut blocks = Vec::with_capacity(n.div_ceil(4096));
+    let mut rest = g.as_mut();
+    while rest.nrows() > 0 {
+        let rows = 4096.min(rest.nrows());
+        let (head, tail) = rest.split_at_row_mut(rows);
+        blocks.push(head);
+        rest = tail;
+    }
+    blocks.into_par_iter().for_each(|mut block| {
+        let mut t = block.rb().transpose().to_owned();
+        llt.solve_in_place(t.as_mut());
+        block.copy_from(t.transpose());
+    });
+    let mut psi = g;
     for (c, &i) in part.retained.iter().enumerate() {
         for cc in 0..nr {
             psi[(i, cc)] = if c == cc { 1.0 } else { 0.0 };
@@ -121,12 +137,26 @@ fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
     out
 }
 
+/// Columns of the basis multiplied by a sparse matrix at a time in [`project_matrix`].
+const PROJECTION_SLAB: usize = 32;
+
 /// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry). For a sparse A
 /// the product is formed as `Tᵀ (A T)`, `A T` by [`symmetric_times`] (one pass over A).
 pub(super) fn project_matrix(a: &Matrix, t: &Mat<f64>) -> Mat<f64> {
     let p = match a {
         Matrix::Dense(d) => t.transpose() * (d * t),
-        Matrix::Sparse(s) => t.transpose() * symmetric_times(s.as_ref(), t.as_ref()),
+        Matrix::Sparse(s) => {
+            // By slabs of columns of T: `A T` whole is an n × m temporary (365 MB for the
+            // 149-vector basis at 306k DOFs).
+            let m = t.ncols();
+            let mut p = Mat::<f64>::zeros(m, m);
+            for c0 in (0..m).step_by(PROJECTION_SLAB) {
+                let w = PROJECTION_SLAB.min(m - c0);
+                let at = symmetric_times(s.as_ref(), t.subcols(c0, w));
+                p.subcols_mut(c0, w).copy_from(t.transpose() * at);
+            }
+            p
+        }
     };
     Mat::from_fn(p.nrows(), p.ncols(), |i, j| 0.5 * (p[(i, j)] + p[(j, i)]))
 }
@@ -192,8 +222,10 @@ fn finish(
     let mut t = Mat::<f64>::zeros(psi.nrows(), nr + nd);
     t.subcols_mut(0, nr).copy_from(&psi);
     t.subcols_mut(nr, nd).copy_from(&dynamic);
+    drop((psi, dynamic));
     let reduced = reduced_model(model, &t, &part.retained)?;
     stages.push(("projection", start.elapsed().as_secs_f64()));
+    crate::memory::stage("projection");
     Ok(Reduction {
         model: reduced,
         basis: t,
@@ -238,6 +270,7 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
         ShiftedFactor::new(kee.as_ref(), Some(mee.as_ref()), 0.0).map_err(ReductionError::InteriorMechanism)?;
     let psi = constraint_modes(k, &part, &factor);
     let mut stages = vec![("constraint modes", start.elapsed().as_secs_f64())];
+    crate::memory::stage("constraint modes");
     let start = Instant::now();
     let (dynamic, freqs) = if opts.modes > 0 {
         let sol = eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?;
@@ -252,6 +285,7 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
         (Mat::zeros(model.n_dofs(), 0), (vec![], vec![]))
     };
     stages.push(("fixed-interface modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("fixed-interface modes");
     finish(model, &part, psi, dynamic, Method::CraigBampton, freqs, stages)
 }
 
@@ -267,6 +301,7 @@ pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduct
     let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
     let dynamic = orthonormalise(model, clean(&phi, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    crate::memory::stage("cleaning and orthogonalisation");
     let freqs = frequencies(&sol);
     finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
 }
@@ -297,6 +332,7 @@ fn static_and_free_modes(
             let t_modes = start.elapsed().as_secs_f64();
             let start = Instant::now();
             if let Some(psi) = constraint_modes_from_full(&part, model.n_dofs(), &factor) {
+                crate::memory::stage("constraint modes");
                 let stages = vec![
                     ("factorisation of K", t_factor),
                     ("free modes", t_modes),
@@ -310,6 +346,7 @@ fn static_and_free_modes(
     let start = Instant::now();
     let sol = eigen::solve(k, m, &eig)?;
     stages.push(("free modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("free modes");
     Ok((part, psi, sol, stages, None))
 }
 
@@ -341,23 +378,27 @@ pub fn enriched(
     let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
-    let k_released = released_stiffness(k, releases, n)?;
+    check_releases(releases, n)?;
     let eig = eigen_options(opts, release_modes.max(1));
     // The factor of K serves the released structure too, through a rank-r update
-    // (`LowRankUpdate`); when the release opens a mechanism at that shift, `K_released` is
-    // factorised at the default (negative) shift instead.
+    // (`LowRankUpdate`), and the products with the released stiffness are K's less the
+    // rank-one terms: no second matrix. When the release opens a mechanism at that shift,
+    // `K_released` is formed and factorised at the default (negative) shift instead, once the
+    // factor of K is freed.
     let updated = factor.as_ref().and_then(|f| {
         let directions = Mat::<f64>::from_fn(n, releases.len(), |i, j| releases[j].direction[i]);
         let stiffness: Vec<f64> = releases.iter().map(|r| r.stiffness).collect();
         LowRankUpdate::new(f, directions, &stiffness).ok()
     });
-    let rel = match &updated {
-        Some(update) => eigen::modes_with_factor(&k_released, m, update, &eig)?,
-        None => eigen::solve(&k_released, m, &eig)?,
-    };
+    let rel = updated.as_ref().map(|update| eigen::modes_of_update(k, m, update, &eig)).transpose()?;
     drop(updated);
     drop(factor);
+    let rel = match rel {
+        Some(rel) => rel,
+        None => eigen::solve(&released_stiffness(k, releases, n)?, m, &eig)?,
+    };
     stages.push(("released modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("released modes");
     let start = Instant::now();
     let (nf, nrel) = (opts.modes, release_modes.min(rel.modes.omega.len()));
     let mut x = Mat::<f64>::zeros(n, nf + nrel);
@@ -365,6 +406,7 @@ pub fn enriched(
     x.subcols_mut(nf, nrel).copy_from(rel.modes.shapes.subcols(0, nrel));
     let dynamic = orthonormalise(model, clean(&x, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    crate::memory::stage("cleaning and orthogonalisation");
     let (mut f, mut r) = frequencies(&sol);
     f.truncate(nf);
     r.truncate(nf);
@@ -373,12 +415,30 @@ pub fn enriched(
     finish(model, &part, psi, dynamic, Method::Enriched, (f, r), stages)
 }
 
+/// Each release's direction is over the `n` DOFs and not zero, its stiffness finite and positive.
+fn check_releases(releases: &[Release], n: usize) -> Result<(), ReductionError> {
+    for r in releases {
+        let bad = |message: String| ReductionError::Release { name: r.name.clone(), message };
+        if r.direction.len() != n {
+            return Err(bad(format!("direction has length {}, expected {n} (one value per DOF)", r.direction.len())));
+        }
+        if !(r.stiffness.is_finite() && r.stiffness > 0.0) {
+            return Err(bad(format!("stiffness must be finite and positive, got {}", r.stiffness)));
+        }
+        if r.direction.iter().all(|v| *v == 0.0) {
+            return Err(bad("direction is zero".into()));
+        }
+    }
+    Ok(())
+}
+
 /// `K − Σ_j k_j d_j d_jᵀ`, checked.
 fn released_stiffness(
     k: &SparseColMat<usize, f64>,
     releases: &[Release],
     n: usize,
 ) -> Result<SparseColMat<usize, f64>, ReductionError> {
+    check_releases(releases, n)?;
     let mut t = Vec::new();
     for r in releases {
         let bad = |message: String| ReductionError::Release { name: r.name.clone(), message };
