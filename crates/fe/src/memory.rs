@@ -39,12 +39,15 @@ pub fn resident() -> Option<(u64, u64)> {
     Some((field("VmRSS:")?, field("VmHWM:")?))
 }
 
-/// Print the resident and peak memory after `stage` when `STICKSLIP_MEMORY` is set.
+/// Print the resident and peak memory after `stage` when `STICKSLIP_MEMORY` is set, in GB as
+/// BENCHMARKS.md gives `/usr/bin/time -v`'s maximum resident set (its kB / 10⁶, kB of 1024
+/// bytes), so that the two compare.
 pub fn stage(stage: &str) {
     if !wanted() {
         return;
     }
     if let Some((rss, hwm)) = resident() {
-        eprintln!("memory after {stage}: resident {:.3} GB, peak {:.3} GB", rss as f64 / 1e9, hwm as f64 / 1e9);
+        let gb = |bytes: u64| bytes as f64 / 1024.0 / 1e6;
+        eprintln!("memory after {stage}: resident {:.3} GB, peak {:.3} GB", gb(rss), gb(hwm));
     }
 }

@@ -204,6 +204,14 @@ fn eigen_options(opts: &ReductionOptions, count: usize) -> EigenOptions {
     EigenOptions { count, ..opts.eigen.clone() }
 }
 
+/// The free modes that go into the basis: the `modes` lowest, or all of a band's.
+fn kept_modes(opts: &ReductionOptions, sol: &EigenSolution) -> usize {
+    match opts.band {
+        Some(_) => sol.modes.omega.len(),
+        None => opts.modes,
+    }
+}
+
 fn frequencies(sol: &EigenSolution) -> (Vec<f64>, Vec<f64>) {
     (sol.modes.frequencies_hz(), sol.residuals.clone())
 }
@@ -272,11 +280,22 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
     let mut stages = vec![("constraint modes", start.elapsed().as_secs_f64())];
     crate::memory::stage("constraint modes");
     let start = Instant::now();
-    let (dynamic, freqs) = if opts.modes > 0 {
-        let sol = eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?;
-        let mut phi = Mat::<f64>::zeros(model.n_dofs(), opts.modes);
+    let sol = match opts.band {
+        // A band has its own shifts: the factor of K_ee is freed first (one factor at a time).
+        Some((lower, upper)) => {
+            drop(factor);
+            Some(eigen::solve_band(&kee, &mee, lower, upper, &opts.eigen)?)
+        }
+        None if opts.modes > 0 => {
+            Some(eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?)
+        }
+        None => None,
+    };
+    let (dynamic, freqs) = if let Some(sol) = sol.filter(|s| !s.modes.omega.is_empty()) {
+        let count = sol.modes.omega.len();
+        let mut phi = Mat::<f64>::zeros(model.n_dofs(), count);
         for (p, &i) in part.interior.iter().enumerate() {
-            for c in 0..opts.modes {
+            for c in 0..count {
                 phi[(i, c)] = sol.modes.shapes[(p, c)];
             }
         }
@@ -298,7 +317,7 @@ pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduct
     let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, _) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
-    let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
+    let phi = sol.modes.shapes.subcols(0, kept_modes(opts, &sol)).to_owned();
     let dynamic = orthonormalise(model, clean(&phi, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
     crate::memory::stage("cleaning and orthogonalisation");
@@ -322,6 +341,32 @@ fn static_and_free_modes(
     opts: &ReductionOptions,
 ) -> Result<StaticAndFree, ReductionError> {
     let part = partition(model, &opts.retained)?;
+    if let Some((lower, upper)) = opts.band {
+        // The band's modes first, at their own shifts, so that one factor is held at a time;
+        // then the constraint modes as below, from the factor of K when K is positive definite
+        // (kept for the released modes of `enriched`), otherwise from K_ee.
+        let start = Instant::now();
+        let sol = eigen::solve_band(k, m, lower, upper, &opts.eigen)?;
+        let t_modes = start.elapsed().as_secs_f64();
+        crate::memory::stage("free modes");
+        let start = Instant::now();
+        if let Ok(factor) = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), 0.0) {
+            let t_factor = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            if let Some(psi) = constraint_modes_from_full(&part, model.n_dofs(), &factor) {
+                crate::memory::stage("constraint modes");
+                let stages = vec![
+                    ("free modes", t_modes),
+                    ("factorisation of K", t_factor),
+                    ("constraint modes", start.elapsed().as_secs_f64()),
+                ];
+                return Ok((part, psi, sol, stages, Some(factor)));
+            }
+        }
+        let (part, psi, mut stages) = static_part(model, k, &opts.retained)?;
+        stages.insert(0, ("free modes", t_modes));
+        return Ok((part, psi, sol, stages, None));
+    }
     let eig = eigen_options(opts, opts.modes.max(1));
     if opts.eigen.shift.is_none() {
         let start = Instant::now();
@@ -400,7 +445,7 @@ pub fn enriched(
     stages.push(("released modes", start.elapsed().as_secs_f64()));
     crate::memory::stage("released modes");
     let start = Instant::now();
-    let (nf, nrel) = (opts.modes, release_modes.min(rel.modes.omega.len()));
+    let (nf, nrel) = (kept_modes(opts, &sol), release_modes.min(rel.modes.omega.len()));
     let mut x = Mat::<f64>::zeros(n, nf + nrel);
     x.subcols_mut(0, nf).copy_from(sol.modes.shapes.subcols(0, nf));
     x.subcols_mut(nf, nrel).copy_from(rel.modes.shapes.subcols(0, nrel));

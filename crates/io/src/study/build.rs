@@ -901,7 +901,7 @@ fn reduce(
             n
         }
     };
-    let options = ReductionOptions { retained, modes, eigen: EigenOptions::default() };
+    let options = ReductionOptions { retained, modes, band: None, eigen: EigenOptions::default() };
     match spec.method {
         ReductionMethod::CraigBampton => reduction::craig_bampton(full, &options),
         ReductionMethod::FreeModes => reduction::free_modes(full, &options),
