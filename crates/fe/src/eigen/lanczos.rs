@@ -118,7 +118,7 @@ pub fn modes_with_factor(
         if converged == nev || ncv == n {
             let shapes = ritz_vectors(v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma);
             drop((v, mv));
-            return finish(k, m, shapes, sigma, factor, solves, restarts, opts);
+            return finish(k, m, shapes, factor, solves, restarts, opts);
         }
         if restarts == opts.max_restarts {
             let worst = order[..nev].iter().map(|&i| residual(i)).fold(0.0, f64::max);
@@ -161,12 +161,12 @@ fn finish(
     k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
     mut shapes: Mat<f64>,
-    sigma: f64,
     factor: &dyn ShiftInvert,
     solves: usize,
     restarts: usize,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
+    let sigma = factor.shift();
     // The Ritz estimates bound the residual of the Krylov recurrence; the true residual also
     // carries the error of the solves, which on large models with 1e10 N/m connectors can
     // exceed the limit (seen: 1.05e-6 on the 2.7 Hz suspension mode of the 306k-DOF Harmony
@@ -362,7 +362,7 @@ fn block_krylov(
             let sigma = factor.shift();
             let shapes = ritz_vectors(v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma);
             drop((v, mv));
-            return finish(k, m, shapes, sigma, factor, solves, restarts, opts).map(Some);
+            return finish(k, m, shapes, factor, solves, restarts, opts).map(Some);
         }
         if new_dim == dim {
             return Ok(None);
