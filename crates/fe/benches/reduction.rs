@@ -120,7 +120,8 @@ fn run(size: &Size, repeat: usize, inp_dir: Option<&std::path::Path>) {
         let fe = FeModel::assemble(mesh).expect("assembly");
         t_asm.push(start.elapsed().as_secs_f64());
         m_asm = m_asm.max(peak_rss_mib());
-        let opts = ReductionOptions { retained: retained(&fe), modes: MODES, eigen: EigenOptions::default() };
+        let opts =
+            ReductionOptions { retained: retained(&fe), modes: MODES, band: None, eigen: EigenOptions::default() };
         peak_rss_reset();
         let red = reduction::free_modes(&fe.model, &opts).expect("reduction");
         m_red = m_red.max(peak_rss_mib());

@@ -8,6 +8,7 @@ pub mod assembly;
 pub mod eigen;
 pub mod element;
 pub mod harmony;
+pub mod memory;
 pub mod mesh;
 pub mod patch;
 pub mod reduction;

@@ -23,7 +23,8 @@ fn free_mode_reduction_keeps_the_modes_and_the_frf_of_the_full_model() {
         .flat_map(|s| fe.set_dofs(s).unwrap())
         .collect();
     assert_eq!(retained.len(), 103);
-    let opts = ReductionOptions { retained: retained.clone(), modes: MODES, eigen: EigenOptions::default() };
+    let opts =
+        ReductionOptions { retained: retained.clone(), modes: MODES, band: None, eigen: EigenOptions::default() };
     let red = free_modes(&fe.model, &opts).unwrap();
 
     // Full model: enough modes to cover the FRF band and keep its frequencies off them.

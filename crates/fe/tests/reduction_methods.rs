@@ -49,7 +49,7 @@ fn case() -> Case {
 }
 
 fn options(case: &Case, modes: usize) -> ReductionOptions {
-    ReductionOptions { retained: case.retained.clone(), modes, eigen: EigenOptions::default() }
+    ReductionOptions { retained: case.retained.clone(), modes, band: None, eigen: EigenOptions::default() }
 }
 
 fn static_solution(model: &LinearModel, f: &[f64]) -> Vec<f64> {
@@ -253,7 +253,8 @@ fn damping_and_loads_are_carried_over() {
 fn bad_retained_sets_are_clear_errors() {
     let case = case();
     let n = case.model.n_dofs();
-    let with = |retained: Vec<usize>| ReductionOptions { retained, modes: 3, eigen: EigenOptions::default() };
+    let with =
+        |retained: Vec<usize>| ReductionOptions { retained, modes: 3, band: None, eigen: EigenOptions::default() };
     assert!(matches!(reduction::free_modes(&case.model, &with(vec![])), Err(ReductionError::NothingRetained)));
     assert!(matches!(
         reduction::craig_bampton(&case.model, &with(vec![1, n])),

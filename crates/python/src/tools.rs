@@ -128,7 +128,7 @@ pub fn reduce<'py>(
             let dofs = (0..n).map(|i| DofLabel::named(format!("{}", i + 1))).collect();
             let model = LinearModel::new(Matrix::Dense(m), Matrix::Dense(k), Damping::None, dofs, Vec::new())
                 .map_err(|e| InputError::new_err(chain(&e)))?;
-            let options = ReductionOptions { retained, modes, eigen: EigenOptions::default() };
+            let options = ReductionOptions { retained, modes, band: None, eigen: EigenOptions::default() };
             match method.as_str() {
                 "cb" => reduction::craig_bampton(&model, &options),
                 "free" => reduction::free_modes(&model, &options),

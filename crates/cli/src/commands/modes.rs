@@ -224,7 +224,7 @@ pub fn shift_from_hz(hz: Option<f64>) -> Option<f64> {
 }
 
 /// ω² in rad²/s² of a frequency in Hz.
-fn lambda_from_hz(f: f64) -> f64 {
+pub fn lambda_from_hz(f: f64) -> f64 {
     (std::f64::consts::TAU * f).powi(2)
 }
 

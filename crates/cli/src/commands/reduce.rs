@@ -10,7 +10,7 @@ use stickslip_fe::eigen::EigenOptions;
 use stickslip_fe::reduction::{self, Reduction, ReductionOptions, Release};
 use stickslip_io::matrix::{mtx, npz};
 
-use super::modes::{load, shift_from_hz, Loaded, ModelArgs};
+use super::modes::{lambda_from_hz, load, parse_band, shift_from_hz, Loaded, ModelArgs};
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum MethodArg {
@@ -33,13 +33,19 @@ pub struct Args {
     /// Number of (free or fixed-interface) modes in the basis.
     #[arg(long, default_value_t = 20)]
     pub modes: usize,
+    /// Instead of --modes: every (free or fixed-interface) mode with F1 <= f <= F2 (Hz, F1:F2,
+    /// e.g. 0:3000), however many there are, counted by the inertia of K - sigma M at both ends
+    /// as `stickslip modes --band` does. Not with --modes or --shift.
+    #[arg(long, value_name = "F1:F2", conflicts_with_all = ["modes", "shift"], allow_hyphen_values = true)]
+    pub band: Option<String>,
     #[arg(long, value_enum, default_value = "free")]
     pub method: MethodArg,
     /// A joint to release for `--method enriched`: `A-B@K` (connector of stiffness K N/m
     /// between DOFs A and B, e.g. `12.3-40.3@1e8`) or `A@K` (to the ground). Repeatable.
     #[arg(long)]
     pub release: Vec<String>,
-    /// Number of released-structure modes added by `--method enriched` (default: --modes).
+    /// Number of released-structure modes added by `--method enriched` (default: --modes;
+    /// required with --band).
     #[arg(long)]
     pub release_modes: Option<usize>,
     /// Shift (Hz) of the eigensolver: modes nearest it (default: the lowest modes).
@@ -118,12 +124,20 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let loaded = load(&args.model)?;
     let retained = retained_dofs(&args.retain, &loaded)?;
     eprintln!("retained: {} DOFs", retained.len());
+    let band = args.band.as_deref().map(parse_band).transpose()?;
+    if band.is_some() && matches!(args.method, MethodArg::Enriched) && args.release_modes.is_none() {
+        bail!("--band with --method enriched: give the number of released-structure modes (--release-modes)");
+    }
     let opts = ReductionOptions {
         retained,
         modes: args.modes,
+        band: band.map(|(f1, f2)| (lambda_from_hz(f1), lambda_from_hz(f2))),
         eigen: EigenOptions { shift: shift_from_hz(args.shift), ..Default::default() },
     };
     let start = Instant::now();
+    if let Some((f1, f2)) = band {
+        eprintln!("basis modes: every one between {f1} and {f2} Hz");
+    }
     let red = match args.method {
         MethodArg::Cb => reduction::craig_bampton(&loaded.model, &opts)?,
         MethodArg::Free => reduction::free_modes(&loaded.model, &opts)?,

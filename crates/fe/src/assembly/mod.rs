@@ -85,7 +85,9 @@ impl FeModel {
         for e in points {
             builder.push(e);
         }
+        crate::memory::stage("element contributions");
         let (k, m) = builder.finish();
+        crate::memory::stage("assembly");
         let labels = dofs.independent.iter().map(|&(node, d)| DofLabel::nodal(mesh.nodes[node].id, d)).collect();
         // Built directly: K and M are symmetric by construction, and LinearModel::new's
         // symmetry check works on dense copies, out of reach at FE sizes.

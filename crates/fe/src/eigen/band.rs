@@ -92,7 +92,7 @@ fn band_ends(
     lower: f64,
     upper: f64,
 ) -> Result<(ShiftedFactor, (f64, usize), (f64, usize)), EigenError> {
-    lanczos::check_sizes(k, m)?;
+    lanczos::check_sizes(&super::product::Stiffness::Sparse(k), m)?;
     if !(lower.is_finite() && upper.is_finite()) {
         return Err(EigenError::Band(format!("the ends must be finite, got [{lower}, {upper}] rad^2/s^2")));
     }
@@ -216,7 +216,7 @@ fn solve_part(
         let wanted = (count + extra).min(n);
         let block = wanted.div_ceil(3).clamp(1, 16) << attempt;
         let sol = lanczos::modes_with_factor(
-            k,
+            &super::product::Stiffness::Sparse(k),
             m,
             &*factor,
             &EigenOptions { count: wanted, shift: Some(shift), block: Some(block.min(n)), ..opts.clone() },

@@ -8,13 +8,14 @@
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMat;
-use faer::{Accum, Mat, MatRef, Par, Side};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+use rayon::prelude::*;
 use stickslip_core::model::{symmetric_eigen, Modes};
 
-use super::product::symmetric_product;
+use super::product::{symmetric_product, Stiffness};
 use super::{EigenError, EigenOptions, EigenSolution, ShiftInvert};
 
-pub(super) fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Result<(), EigenError> {
+pub(super) fn check_sizes(k: &Stiffness<'_>, m: &SparseColMat<usize, f64>) -> Result<(), EigenError> {
     if k.nrows() != k.ncols() || m.nrows() != m.ncols() || k.nrows() != m.nrows() {
         return Err(EigenError::Size { k_rows: k.nrows(), k_cols: k.ncols(), m_rows: m.nrows(), m_cols: m.ncols() });
     }
@@ -24,7 +25,7 @@ pub(super) fn check_sizes(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, 
 /// The `opts.count` modes of `(K, M)` nearest the shift of `factor`, an existing
 /// factorisation of `K − σM` or an update of one.
 pub fn modes_with_factor(
-    k: &SparseColMat<usize, f64>,
+    k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
     factor: &dyn ShiftInvert,
     opts: &EigenOptions,
@@ -115,7 +116,9 @@ pub fn modes_with_factor(
         let residual = |i: usize| (beta_m * y[(ncv - 1, i)]).abs() / theta[i].abs().max(f64::MIN_POSITIVE);
         let converged = order[..nev].iter().filter(|&&i| residual(i) <= opts.tolerance).count();
         if converged == nev || ncv == n {
-            return finish(k, m, v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma, factor, solves, restarts, opts);
+            let shapes = ritz_vectors(v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma);
+            drop((v, mv));
+            return finish(k, m, shapes, factor, solves, restarts, opts);
         }
         if restarts == opts.max_restarts {
             let worst = order[..nev].iter().map(|&i| residual(i)).fold(0.0, f64::max);
@@ -125,12 +128,10 @@ pub fn modes_with_factor(
         restarts += 1;
         let keep = (nev + (ncv - nev) / 2).min(ncv - 1);
         let y_keep = Mat::<f64>::from_fn(ncv, keep, |i, c| y[(i, order[c])]);
-        let new_v = v.subcols(0, ncv) * &y_keep;
-        let new_mv = mv.subcols(0, ncv) * &y_keep;
+        combine_in_place(v.as_mut(), y_keep.as_ref());
+        combine_in_place(mv.as_mut(), y_keep.as_ref());
         let last = v.col(ncv).to_owned();
         let mlast = mv.col(ncv).to_owned();
-        v.subcols_mut(0, keep).copy_from(&new_v);
-        mv.subcols_mut(0, keep).copy_from(&new_mv);
         v.col_mut(keep).copy_from(&last);
         mv.col_mut(keep).copy_from(&mlast);
         h.fill(0.0);
@@ -143,25 +144,29 @@ pub fn modes_with_factor(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The wanted Ritz vectors `V y_i` in increasing order of their eigenvalue `σ + 1/θ_i`.
+fn ritz_vectors(v: MatRef<'_, f64>, y: MatRef<'_, f64>, theta: &[f64], wanted: &[usize], sigma: f64) -> Mat<f64> {
+    crate::memory::stage("Lanczos iteration");
+    let ncv = y.nrows();
+    let mut pairs: Vec<(f64, usize)> = wanted.iter().map(|&i| (sigma + 1.0 / theta[i], i)).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let ysel = Mat::<f64>::from_fn(ncv, pairs.len(), |r, c| y[(r, pairs[c].1)]);
+    v.subcols(0, ncv) * &ysel
+}
+
+/// The modes from the Ritz vectors `shapes` (see [`ritz_vectors`]), checked and refined. The
+/// Krylov basis is freed before: the products here are n × count blocks, and with the basis
+/// (0.7 GB at 306k DOFs and 34 modes) they made the peak of the eigensolution.
 fn finish(
-    k: &SparseColMat<usize, f64>,
+    k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
-    v: MatRef<'_, f64>,
-    y: MatRef<'_, f64>,
-    theta: &[f64],
-    wanted: &[usize],
-    sigma: f64,
+    mut shapes: Mat<f64>,
     factor: &dyn ShiftInvert,
     solves: usize,
     restarts: usize,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
-    let ncv = y.nrows();
-    let mut pairs: Vec<(f64, usize)> = wanted.iter().map(|&i| (sigma + 1.0 / theta[i], i)).collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let ysel = Mat::<f64>::from_fn(ncv, pairs.len(), |r, c| y[(r, pairs[c].1)]);
-    let mut shapes = v.subcols(0, ncv) * &ysel;
+    let sigma = factor.shift();
     // The Ritz estimates bound the residual of the Krylov recurrence; the true residual also
     // carries the error of the solves, which on large models with 1e10 N/m connectors can
     // exceed the limit (seen: 1.05e-6 on the 2.7 Hz suspension mode of the 306k-DOF Harmony
@@ -201,7 +206,7 @@ const REFINEMENT_PASSES: usize = 2;
 /// `‖Kφ − ω²Mφ‖ / max(‖Kφ‖, |σ| ‖Mφ‖)` (rigid-body modes, whose `Kφ` vanishes, are measured
 /// against the shift).
 fn rayleigh_quotients(
-    k: &SparseColMat<usize, f64>,
+    k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
     shapes: &mut Mat<f64>,
     sigma: f64,
@@ -209,7 +214,7 @@ fn rayleigh_quotients(
     let (n, p) = (shapes.nrows(), shapes.ncols());
     let mut kx = Mat::<f64>::zeros(n, p);
     let mut mx = Mat::<f64>::zeros(n, p);
-    symmetric_product(kx.as_mut(), k.as_ref(), shapes.as_ref());
+    k.product(kx.as_mut(), shapes.as_ref());
     symmetric_product(mx.as_mut(), m.as_ref(), shapes.as_ref());
     let mut omega = Vec::with_capacity(p);
     let mut residuals = Vec::with_capacity(p);
@@ -236,7 +241,7 @@ fn rayleigh_quotients(
 /// One subspace iteration `X ← (K − σM)⁻¹ M X` on the block, then Rayleigh-Ritz: the modes of
 /// `(Xᵀ K X, Xᵀ M X)` in increasing order.
 fn refine(
-    k: &SparseColMat<usize, f64>,
+    k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
     factor: &dyn ShiftInvert,
     shapes: &mut Mat<f64>,
@@ -247,7 +252,7 @@ fn refine(
     factor.solve_in_place(x.as_mut());
     let mut kx = Mat::<f64>::zeros(n, p);
     let mut mx = Mat::<f64>::zeros(n, p);
-    symmetric_product(kx.as_mut(), k.as_ref(), x.as_ref());
+    k.product(kx.as_mut(), x.as_ref());
     symmetric_product(mx.as_mut(), m.as_ref(), x.as_ref());
     let kr = x.transpose() * &kx;
     let mr = x.transpose() * &mx;
@@ -300,7 +305,7 @@ fn restart_direction(m: &SparseColMat<usize, f64>, v: &mut Mat<f64>, mv: &mut Ma
 /// block solves carry the whole iteration. `None` when the Krylov space closes before the
 /// wanted modes are in it (the caller falls back on single-vector thick restart).
 fn block_krylov(
-    k: &SparseColMat<usize, f64>,
+    k: &Stiffness<'_>,
     m: &SparseColMat<usize, f64>,
     factor: &dyn ShiftInvert,
     opts: &EigenOptions,
@@ -355,8 +360,9 @@ fn block_krylov(
             |i: usize| coupling(i).iter().map(|x| x * x).sum::<f64>().sqrt() / theta[i].abs().max(f64::MIN_POSITIVE);
         if dim >= nev && order[..nev].iter().all(|&i| residual(i) <= opts.tolerance) {
             let sigma = factor.shift();
-            return finish(k, m, v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma, factor, solves, restarts, opts)
-                .map(Some);
+            let shapes = ritz_vectors(v.as_ref(), y.as_ref(), &theta, &order[..nev], sigma);
+            drop((v, mv));
+            return finish(k, m, shapes, factor, solves, restarts, opts).map(Some);
         }
         if new_dim == dim {
             return Ok(None);
@@ -378,12 +384,10 @@ fn block_krylov(
         let keep = (nev + (max_dim - nev) / 3).min(dim).min(v.ncols() - nb_new - b);
         let y = Mat::<f64>::from_fn(dim, keep, |r, c| y[(r, order[c])]);
         let couplings: Vec<Vec<f64>> = (0..keep).map(|c| coupling(order[c])).collect();
-        let new_v = v.subcols(0, dim) * &y;
-        let new_mv = mv.subcols(0, dim) * &y;
+        combine_in_place(v.as_mut(), y.as_ref());
+        combine_in_place(mv.as_mut(), y.as_ref());
         let last = v.subcols(dim, nb_new).to_owned();
         let mlast = mv.subcols(dim, nb_new).to_owned();
-        v.subcols_mut(0, keep).copy_from(&new_v);
-        mv.subcols_mut(0, keep).copy_from(&new_mv);
         v.subcols_mut(keep, nb_new).copy_from(&last);
         mv.subcols_mut(keep, nb_new).copy_from(&mlast);
         h.fill(0.0);
@@ -447,6 +451,27 @@ fn append_block(
     v.subcols_mut(dim, nb).copy_from(&w);
     mv.subcols_mut(dim, nb).copy_from(&mw);
     dim + nb
+}
+
+/// `V[:, 0..keep] ← V[:, 0..dim] Y` for `Y` of `dim × keep` (`keep ≤ dim`), in place by blocks
+/// of rows: a row of the product needs only the same row of V, so the restart forms no
+/// `n × keep` temporary (two of 161 MB, for V and M V, at 306k DOFs and 66 kept vectors).
+fn combine_in_place(v: MatMut<'_, f64>, y: MatRef<'_, f64>) {
+    const ROWS: usize = 2048;
+    let (dim, keep) = (y.nrows(), y.ncols());
+    debug_assert!(keep <= dim && dim <= v.ncols());
+    let mut blocks = Vec::with_capacity(v.nrows().div_ceil(ROWS));
+    let mut rest = v;
+    while rest.nrows() > 0 {
+        let rows = ROWS.min(rest.nrows());
+        let (head, tail) = rest.split_at_row_mut(rows);
+        blocks.push(head);
+        rest = tail;
+    }
+    blocks.into_par_iter().for_each(|block| {
+        let product = block.rb().subcols(0, dim) * y;
+        block.subcols_mut(0, keep).copy_from(&product);
+    });
 }
 
 fn projection_failed() -> EigenError {

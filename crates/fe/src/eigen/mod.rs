@@ -16,6 +16,7 @@ mod update;
 
 pub use band::{count_in_band, solve_band, solve_band_split, MODES_PER_SHIFT};
 pub use factor::{ShiftInvert, ShiftedFactor};
+use product::Stiffness;
 pub use product::{symmetric_product, symmetric_times};
 pub use update::LowRankUpdate;
 
@@ -114,7 +115,7 @@ pub fn solve(
     m: &SparseColMat<usize, f64>,
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
-    lanczos::check_sizes(k, m)?;
+    lanczos::check_sizes(&Stiffness::Sparse(k), m)?;
     let shift = opts.shift.unwrap_or_else(|| default_shift(k, m));
     check_mass(m, None)?;
     let factor = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), shift)?;
@@ -130,7 +131,24 @@ pub fn modes_with_factor(
     opts: &EigenOptions,
 ) -> Result<EigenSolution, EigenError> {
     check_mass(m, None)?;
-    let solution = lanczos::modes_with_factor(k, m, factor, opts)?;
+    let solution = lanczos::modes_with_factor(&Stiffness::Sparse(k), m, factor, opts)?;
+    check_mass(m, Some(&solution))?;
+    Ok(solution)
+}
+
+/// The modes of `(K − Σ_j k_j d_j d_jᵀ, M)` (the structure with joints released) nearest the
+/// shift of `update`, the factor of `K − σM` updated for the released joints: neither the
+/// released stiffness nor its factor is formed (the products with it are those of K less the
+/// rank-one terms).
+pub fn modes_of_update(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    update: &LowRankUpdate<'_>,
+    opts: &EigenOptions,
+) -> Result<EigenSolution, EigenError> {
+    check_mass(m, None)?;
+    let (u, c) = update.terms();
+    let solution = lanczos::modes_with_factor(&Stiffness::LessRankOnes { k, u, c }, m, update, opts)?;
     check_mass(m, Some(&solution))?;
     Ok(solution)
 }

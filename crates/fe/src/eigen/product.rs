@@ -9,9 +9,12 @@
 //! symmetric, column `j` of `A` is its row `j`, so every output row is a gather that threads
 //! compute independently.
 use faer::reborrow::ReborrowMut;
-use faer::sparse::SparseColMatRef;
+use faer::sparse::{SparseColMat, SparseColMatRef};
 use faer::{Mat, MatMut, MatRef};
 use rayon::prelude::*;
+
+/// Widest block multiplied in one pass over the matrix (see [`symmetric_product`]).
+const SLAB: usize = 32;
 
 /// Rows of the output per parallel task.
 const ROWS_PER_TASK: usize = 2048;
@@ -28,6 +31,18 @@ pub fn symmetric_product(mut out: MatMut<'_, f64>, a: SparseColMatRef<'_, usize,
         out.ncols()
     );
     if b == 0 || n == 0 {
+        return;
+    }
+    if b > SLAB {
+        // Wide blocks (the reduction basis, 149 columns at 306k DOFs) by slabs of columns: the
+        // row-ordered copies below are two n × b temporaries (730 MB for the whole basis),
+        // against one more pass over A per slab. Each entry is summed as in one pass.
+        let slabs = b.div_ceil(SLAB);
+        let width = b.div_ceil(slabs);
+        for c0 in (0..b).step_by(width) {
+            let w = width.min(b - c0);
+            symmetric_product(out.rb_mut().subcols_mut(c0, w), a, x.subcols(c0, w));
+        }
         return;
     }
     let mut xr = vec![0.0; n * b];
@@ -50,6 +65,48 @@ pub fn symmetric_product(mut out: MatMut<'_, f64>, a: SparseColMatRef<'_, usize,
     for c in 0..b {
         for (i, v) in out.rb_mut().col_mut(c).iter_mut().enumerate() {
             *v = yr[i * b + c];
+        }
+    }
+}
+
+/// The stiffness of an eigenproblem, known through its products: a symmetric sparse matrix, or
+/// one less a few rank-one terms (the structure with joints released, `K − U C Uᵀ`), which
+/// needs no copy of K (0.66 GB at 306k DOFs).
+pub enum Stiffness<'a> {
+    Sparse(&'a SparseColMat<usize, f64>),
+    /// `K − U diag(c) Uᵀ`.
+    LessRankOnes {
+        k: &'a SparseColMat<usize, f64>,
+        u: MatRef<'a, f64>,
+        c: &'a [f64],
+    },
+}
+
+impl Stiffness<'_> {
+    fn matrix(&self) -> &SparseColMat<usize, f64> {
+        match self {
+            Stiffness::Sparse(k) | Stiffness::LessRankOnes { k, .. } => k,
+        }
+    }
+
+    pub fn nrows(&self) -> usize {
+        self.matrix().nrows()
+    }
+
+    pub fn ncols(&self) -> usize {
+        self.matrix().ncols()
+    }
+
+    /// `out = A X`.
+    pub fn product(&self, mut out: MatMut<'_, f64>, x: MatRef<'_, f64>) {
+        symmetric_product(out.rb_mut(), self.matrix().as_ref(), x);
+        if let Stiffness::LessRankOnes { u, c, .. } = self {
+            // out −= U (C (Uᵀ X)): r × b coefficients.
+            let mut coef = u.transpose() * x;
+            for (j, &cj) in c.iter().enumerate() {
+                coef.row_mut(j).iter_mut().for_each(|v| *v *= cj);
+            }
+            faer::linalg::matmul::matmul(out, faer::Accum::Add, *u, coef.as_ref(), -1.0, faer::Par::Seq);
         }
     }
 }

@@ -20,6 +20,8 @@ pub struct LowRankUpdate<'a> {
     base: &'a ShiftedFactor,
     /// The directions `d_j`, one per column.
     u: Mat<f64>,
+    /// The `k_j`.
+    stiffness: Vec<f64>,
     /// `A⁻¹ U`.
     a_inv_u: Mat<f64>,
     /// `S⁻¹`.
@@ -57,7 +59,14 @@ impl<'a> LowRankUpdate<'a> {
         }
         let s_inv = Mat::<f64>::from_fn(r, r, |i, j| (0..r).map(|l| q[(i, l)] * q[(j, l)] / mu[l]).sum());
         let below = base.eigenvalues_below_shift() + mu.iter().filter(|m| **m < 0.0).count();
-        Ok(LowRankUpdate { base, u: directions, a_inv_u, s_inv, below })
+        Ok(LowRankUpdate { base, u: directions, stiffness: stiffness.to_vec(), a_inv_u, s_inv, below })
+    }
+}
+
+impl LowRankUpdate<'_> {
+    /// The directions `d_j` (columns) and the stiffnesses `k_j` removed.
+    pub fn terms(&self) -> (faer::MatRef<'_, f64>, &[f64]) {
+        (self.u.as_ref(), &self.stiffness)
     }
 }
 

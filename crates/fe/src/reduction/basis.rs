@@ -3,8 +3,10 @@
 use std::time::Instant;
 
 use faer::prelude::Solve;
+use faer::reborrow::Reborrow;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Mat, Side};
+use rayon::prelude::*;
 use stickslip_core::model::{symmetric_eigen, LinearModel, Matrix};
 
 use super::{reduced_model, Method, Reduction, ReductionError, ReductionOptions, Release};
@@ -98,9 +100,23 @@ fn constraint_modes_from_full(part: &Partition, n: usize, k: &ShiftedFactor) -> 
     k.solve_in_place(g.as_mut());
     let grr = Mat::<f64>::from_fn(nr, nr, |a, b| 0.5 * (g[(part.retained[a], b)] + g[(part.retained[b], a)]));
     let llt = grr.llt(Side::Lower).ok()?;
-    // Ψ = G G_rr⁻¹, i.e. Ψᵀ = G_rr⁻¹ Gᵀ (G_rr symmetric).
-    let psi_t = llt.solve(g.transpose());
-    let mut psi = psi_t.transpose().to_owned();
+    // Ψ = G G_rr⁻¹, i.e. Ψᵀ = G_rr⁻¹ Gᵀ (G_rr symmetric), in place by blocks of rows of G: no
+    // second and third n × r block (250 MB each at 306k DOFs and 103 retained DOFs) while the
+    // factor of K is held.
+    let mut blocks = Vec::with_capacity(n.div_ceil(4096));
+    let mut rest = g.as_mut();
+    while rest.nrows() > 0 {
+        let rows = 4096.min(rest.nrows());
+        let (head, tail) = rest.split_at_row_mut(rows);
+        blocks.push(head);
+        rest = tail;
+    }
+    blocks.into_par_iter().for_each(|mut block| {
+        let mut t = block.rb().transpose().to_owned();
+        llt.solve_in_place(t.as_mut());
+        block.copy_from(t.transpose());
+    });
+    let mut psi = g;
     for (c, &i) in part.retained.iter().enumerate() {
         for cc in 0..nr {
             psi[(i, cc)] = if c == cc { 1.0 } else { 0.0 };
@@ -121,12 +137,26 @@ fn clean(phi: &Mat<f64>, psi: &Mat<f64>, part: &Partition) -> Mat<f64> {
     out
 }
 
+/// Columns of the basis multiplied by a sparse matrix at a time in [`project_matrix`].
+const PROJECTION_SLAB: usize = 32;
+
 /// `Tᵀ A T`, symmetrised (A is symmetric; this removes round-off asymmetry). For a sparse A
 /// the product is formed as `Tᵀ (A T)`, `A T` by [`symmetric_times`] (one pass over A).
 pub(super) fn project_matrix(a: &Matrix, t: &Mat<f64>) -> Mat<f64> {
     let p = match a {
         Matrix::Dense(d) => t.transpose() * (d * t),
-        Matrix::Sparse(s) => t.transpose() * symmetric_times(s.as_ref(), t.as_ref()),
+        Matrix::Sparse(s) => {
+            // By slabs of columns of T: `A T` whole is an n × m temporary (365 MB for the
+            // 149-vector basis at 306k DOFs).
+            let m = t.ncols();
+            let mut p = Mat::<f64>::zeros(m, m);
+            for c0 in (0..m).step_by(PROJECTION_SLAB) {
+                let w = PROJECTION_SLAB.min(m - c0);
+                let at = symmetric_times(s.as_ref(), t.subcols(c0, w));
+                p.subcols_mut(c0, w).copy_from(t.transpose() * at);
+            }
+            p
+        }
     };
     Mat::from_fn(p.nrows(), p.ncols(), |i, j| 0.5 * (p[(i, j)] + p[(j, i)]))
 }
@@ -174,6 +204,14 @@ fn eigen_options(opts: &ReductionOptions, count: usize) -> EigenOptions {
     EigenOptions { count, ..opts.eigen.clone() }
 }
 
+/// The free modes that go into the basis: the `modes` lowest, or all of a band's.
+fn kept_modes(opts: &ReductionOptions, sol: &EigenSolution) -> usize {
+    match opts.band {
+        Some(_) => sol.modes.omega.len(),
+        None => opts.modes,
+    }
+}
+
 fn frequencies(sol: &EigenSolution) -> (Vec<f64>, Vec<f64>) {
     (sol.modes.frequencies_hz(), sol.residuals.clone())
 }
@@ -192,8 +230,10 @@ fn finish(
     let mut t = Mat::<f64>::zeros(psi.nrows(), nr + nd);
     t.subcols_mut(0, nr).copy_from(&psi);
     t.subcols_mut(nr, nd).copy_from(&dynamic);
+    drop((psi, dynamic));
     let reduced = reduced_model(model, &t, &part.retained)?;
     stages.push(("projection", start.elapsed().as_secs_f64()));
+    crate::memory::stage("projection");
     Ok(Reduction {
         model: reduced,
         basis: t,
@@ -238,12 +278,24 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
         ShiftedFactor::new(kee.as_ref(), Some(mee.as_ref()), 0.0).map_err(ReductionError::InteriorMechanism)?;
     let psi = constraint_modes(k, &part, &factor);
     let mut stages = vec![("constraint modes", start.elapsed().as_secs_f64())];
+    crate::memory::stage("constraint modes");
     let start = Instant::now();
-    let (dynamic, freqs) = if opts.modes > 0 {
-        let sol = eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?;
-        let mut phi = Mat::<f64>::zeros(model.n_dofs(), opts.modes);
+    let sol = match opts.band {
+        // A band has its own shifts: the factor of K_ee is freed first (one factor at a time).
+        Some((lower, upper)) => {
+            drop(factor);
+            Some(eigen::solve_band(&kee, &mee, lower, upper, &opts.eigen)?)
+        }
+        None if opts.modes > 0 => {
+            Some(eigen::modes_with_factor(&kee, &mee, &factor, &eigen_options(opts, opts.modes))?)
+        }
+        None => None,
+    };
+    let (dynamic, freqs) = if let Some(sol) = sol.filter(|s| !s.modes.omega.is_empty()) {
+        let count = sol.modes.omega.len();
+        let mut phi = Mat::<f64>::zeros(model.n_dofs(), count);
         for (p, &i) in part.interior.iter().enumerate() {
-            for c in 0..opts.modes {
+            for c in 0..count {
                 phi[(i, c)] = sol.modes.shapes[(p, c)];
             }
         }
@@ -252,6 +304,7 @@ pub fn craig_bampton(model: &LinearModel, opts: &ReductionOptions) -> Result<Red
         (Mat::zeros(model.n_dofs(), 0), (vec![], vec![]))
     };
     stages.push(("fixed-interface modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("fixed-interface modes");
     finish(model, &part, psi, dynamic, Method::CraigBampton, freqs, stages)
 }
 
@@ -264,9 +317,10 @@ pub fn free_modes(model: &LinearModel, opts: &ReductionOptions) -> Result<Reduct
     let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, _) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
-    let phi = sol.modes.shapes.subcols(0, opts.modes).to_owned();
+    let phi = sol.modes.shapes.subcols(0, kept_modes(opts, &sol)).to_owned();
     let dynamic = orthonormalise(model, clean(&phi, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    crate::memory::stage("cleaning and orthogonalisation");
     let freqs = frequencies(&sol);
     finish(model, &part, psi, dynamic, Method::FreeModes, freqs, stages)
 }
@@ -287,6 +341,32 @@ fn static_and_free_modes(
     opts: &ReductionOptions,
 ) -> Result<StaticAndFree, ReductionError> {
     let part = partition(model, &opts.retained)?;
+    if let Some((lower, upper)) = opts.band {
+        // The band's modes first, at their own shifts, so that one factor is held at a time;
+        // then the constraint modes as below, from the factor of K when K is positive definite
+        // (kept for the released modes of `enriched`), otherwise from K_ee.
+        let start = Instant::now();
+        let sol = eigen::solve_band(k, m, lower, upper, &opts.eigen)?;
+        let t_modes = start.elapsed().as_secs_f64();
+        crate::memory::stage("free modes");
+        let start = Instant::now();
+        if let Ok(factor) = ShiftedFactor::new(k.as_ref(), Some(m.as_ref()), 0.0) {
+            let t_factor = start.elapsed().as_secs_f64();
+            let start = Instant::now();
+            if let Some(psi) = constraint_modes_from_full(&part, model.n_dofs(), &factor) {
+                crate::memory::stage("constraint modes");
+                let stages = vec![
+                    ("free modes", t_modes),
+                    ("factorisation of K", t_factor),
+                    ("constraint modes", start.elapsed().as_secs_f64()),
+                ];
+                return Ok((part, psi, sol, stages, Some(factor)));
+            }
+        }
+        let (part, psi, mut stages) = static_part(model, k, &opts.retained)?;
+        stages.insert(0, ("free modes", t_modes));
+        return Ok((part, psi, sol, stages, None));
+    }
     let eig = eigen_options(opts, opts.modes.max(1));
     if opts.eigen.shift.is_none() {
         let start = Instant::now();
@@ -297,6 +377,7 @@ fn static_and_free_modes(
             let t_modes = start.elapsed().as_secs_f64();
             let start = Instant::now();
             if let Some(psi) = constraint_modes_from_full(&part, model.n_dofs(), &factor) {
+                crate::memory::stage("constraint modes");
                 let stages = vec![
                     ("factorisation of K", t_factor),
                     ("free modes", t_modes),
@@ -310,6 +391,7 @@ fn static_and_free_modes(
     let start = Instant::now();
     let sol = eigen::solve(k, m, &eig)?;
     stages.push(("free modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("free modes");
     Ok((part, psi, sol, stages, None))
 }
 
@@ -341,30 +423,35 @@ pub fn enriched(
     let (k, m) = (&*k, &*m);
     let (part, psi, sol, mut stages, factor) = static_and_free_modes(model, k, m, opts)?;
     let start = Instant::now();
-    let k_released = released_stiffness(k, releases, n)?;
+    check_releases(releases, n)?;
     let eig = eigen_options(opts, release_modes.max(1));
     // The factor of K serves the released structure too, through a rank-r update
-    // (`LowRankUpdate`); when the release opens a mechanism at that shift, `K_released` is
-    // factorised at the default (negative) shift instead.
+    // (`LowRankUpdate`), and the products with the released stiffness are K's less the
+    // rank-one terms: no second matrix. When the release opens a mechanism at that shift,
+    // `K_released` is formed and factorised at the default (negative) shift instead, once the
+    // factor of K is freed.
     let updated = factor.as_ref().and_then(|f| {
         let directions = Mat::<f64>::from_fn(n, releases.len(), |i, j| releases[j].direction[i]);
         let stiffness: Vec<f64> = releases.iter().map(|r| r.stiffness).collect();
         LowRankUpdate::new(f, directions, &stiffness).ok()
     });
-    let rel = match &updated {
-        Some(update) => eigen::modes_with_factor(&k_released, m, update, &eig)?,
-        None => eigen::solve(&k_released, m, &eig)?,
-    };
+    let rel = updated.as_ref().map(|update| eigen::modes_of_update(k, m, update, &eig)).transpose()?;
     drop(updated);
     drop(factor);
+    let rel = match rel {
+        Some(rel) => rel,
+        None => eigen::solve(&released_stiffness(k, releases, n)?, m, &eig)?,
+    };
     stages.push(("released modes", start.elapsed().as_secs_f64()));
+    crate::memory::stage("released modes");
     let start = Instant::now();
-    let (nf, nrel) = (opts.modes, release_modes.min(rel.modes.omega.len()));
+    let (nf, nrel) = (kept_modes(opts, &sol), release_modes.min(rel.modes.omega.len()));
     let mut x = Mat::<f64>::zeros(n, nf + nrel);
     x.subcols_mut(0, nf).copy_from(sol.modes.shapes.subcols(0, nf));
     x.subcols_mut(nf, nrel).copy_from(rel.modes.shapes.subcols(0, nrel));
     let dynamic = orthonormalise(model, clean(&x, &psi, &part))?;
     stages.push(("cleaning and orthogonalisation", start.elapsed().as_secs_f64()));
+    crate::memory::stage("cleaning and orthogonalisation");
     let (mut f, mut r) = frequencies(&sol);
     f.truncate(nf);
     r.truncate(nf);
@@ -373,13 +460,8 @@ pub fn enriched(
     finish(model, &part, psi, dynamic, Method::Enriched, (f, r), stages)
 }
 
-/// `K − Σ_j k_j d_j d_jᵀ`, checked.
-fn released_stiffness(
-    k: &SparseColMat<usize, f64>,
-    releases: &[Release],
-    n: usize,
-) -> Result<SparseColMat<usize, f64>, ReductionError> {
-    let mut t = Vec::new();
+/// Each release's direction is over the `n` DOFs and not zero, its stiffness finite and positive.
+fn check_releases(releases: &[Release], n: usize) -> Result<(), ReductionError> {
     for r in releases {
         let bad = |message: String| ReductionError::Release { name: r.name.clone(), message };
         if r.direction.len() != n {
@@ -388,11 +470,24 @@ fn released_stiffness(
         if !(r.stiffness.is_finite() && r.stiffness > 0.0) {
             return Err(bad(format!("stiffness must be finite and positive, got {}", r.stiffness)));
         }
-        let support: Vec<(usize, f64)> =
-            r.direction.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(i, v)| (i, *v)).collect();
-        if support.is_empty() {
+        if r.direction.iter().all(|v| *v == 0.0) {
             return Err(bad("direction is zero".into()));
         }
+    }
+    Ok(())
+}
+
+/// `K − Σ_j k_j d_j d_jᵀ` (the releases checked by [`check_releases`]), for a factorisation of
+/// its own where the update of K's factor cannot serve.
+fn released_stiffness(
+    k: &SparseColMat<usize, f64>,
+    releases: &[Release],
+    n: usize,
+) -> Result<SparseColMat<usize, f64>, ReductionError> {
+    let mut t = Vec::new();
+    for r in releases {
+        let support: Vec<(usize, f64)> =
+            r.direction.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(i, v)| (i, *v)).collect();
         for &(i, a) in &support {
             for &(j, b) in &support {
                 t.push(Triplet::new(i, j, r.stiffness * a * b));

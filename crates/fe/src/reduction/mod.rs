@@ -63,6 +63,10 @@ pub struct ReductionOptions {
     pub retained: Vec<usize>,
     /// Number of (fixed-interface or free) modes kept.
     pub modes: usize,
+    /// Instead of the `modes` lowest, every mode with `lower ≤ ω² ≤ upper` (rad²/s²), however
+    /// many: counted by the inertia of `K − σM` at the ends and found by
+    /// [`crate::eigen::solve_band`] (`modes` is then not used).
+    pub band: Option<(f64, f64)>,
     /// Eigensolver settings (`count` is overridden by `modes`).
     pub eigen: EigenOptions,
 }

@@ -25,10 +25,11 @@ pub fn lowest_eigenvalue(model: &LinearModel, sigma: f64, deflate: &[Vec<f64>], 
     let (Matrix::Sparse(k), Matrix::Sparse(m)) = (&model.stiffness, &model.mass) else {
         panic!("expected sparse K, M")
     };
-    let a = faer::sparse::SparseColMat::<usize, f64>::new(
-        k.symbolic().to_owned().unwrap(),
-        k.val().iter().zip(m.val()).map(|(a, b)| a + sigma * b).collect(),
-    );
+    // M is stored without the zeros of K's pattern: the sum on the union of the two.
+    let a = faer::sparse::ops::binary_op(k.as_ref(), m.as_ref(), |a, b| {
+        a.copied().unwrap_or(0.0) + sigma * b.copied().unwrap_or(0.0)
+    })
+    .unwrap();
     let llt = a.sp_cholesky(Side::Lower).expect("K + σM positive definite");
     let n = model.n_dofs();
     // M-orthonormal deflation basis (Gram-Schmidt in the M inner product).

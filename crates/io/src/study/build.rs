@@ -210,6 +210,7 @@ impl Study {
                 let started = std::time::Instant::now();
                 let red = reduce(&full, r, &releases, &patch_dofs).map_err(|k| err(r.at, k))?;
                 timings.push(("modes and reduction".into(), started.elapsed().as_secs_f64()));
+                stickslip_fe::memory::stage("modes and reduction");
                 timings.extend(red.stages.iter().map(|(stage, secs)| (format!("  {stage}"), *secs)));
                 (red.model.clone(), Some(red))
             }
@@ -345,6 +346,7 @@ impl Study {
                     .build(stickslip_fe::harmony::Configuration::Assembly)
                     .map_err(|source| err(at.section, StudyErrorKind::Invalid(format!("[model.harmony]: {source}"))))?;
                 timings.push(("mesh".into(), started.elapsed().as_secs_f64()));
+                stickslip_fe::memory::stage("mesh");
                 let started = std::time::Instant::now();
                 let mut fe = FeModel::assemble(mesh).map_err(|source| {
                     err(at.section, StudyErrorKind::Assembly { context: "[model.harmony]".into(), source })
@@ -893,7 +895,7 @@ fn reduce(
             n
         }
     };
-    let options = ReductionOptions { retained, modes, eigen: EigenOptions::default() };
+    let options = ReductionOptions { retained, modes, band: None, eigen: EigenOptions::default() };
     match spec.method {
         ReductionMethod::CraigBampton => reduction::craig_bampton(full, &options),
         ReductionMethod::FreeModes => reduction::free_modes(full, &options),
