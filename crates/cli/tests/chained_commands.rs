@@ -198,8 +198,10 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
         assert!(dir.join("compare").join(plot).exists(), "compare wrote no {plot}");
     }
     // The measured peak of the tip's displacement is the resonance `run` located: the middle
-    // record sits on it, and the parabola through the three highest records moves the peak by
-    // a fraction of their 1.5 % spacing; the amplitudes agree as the FRFs do above.
+    // record sits on it, and the vertex of the parabola through three equally spaced records
+    // whose middle one is highest lies within half their 1.5 % spacing of it (0.75 %; on this
+    // flat-topped friction peak it lands 0.50 % away); the amplitudes agree as the FRFs do
+    // above.
     let text = std::fs::read_to_string(dir.join("compare/peaks.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -209,7 +211,7 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
         .find(|r| r[col("output")] == "tip" && r[col("unit")] == "m_per_N")
         .unwrap_or_else(|| panic!("no tip displacement peak in {text}"));
     let value = |name: &str| row[col(name)].parse::<f64>().unwrap();
-    assert!((value("measured_frequency_Hz") - peak).abs() <= 0.005 * peak, "{text}");
+    assert!((value("measured_frequency_Hz") - peak).abs() <= 0.0075 * peak, "{text}");
     assert!(value("amplitude_error_pct").abs() <= 1.0, "{text}");
 
     // The same folder, one frequency: the other records and plots of the previous timesim
