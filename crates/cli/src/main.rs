@@ -65,7 +65,9 @@ fn main() -> ExitCode {
         eprintln!("error: --threads must be at least 1");
         return ExitCode::FAILURE;
     }
-    let threads = cli.threads.or_else(|| std::env::var_os("RAYON_NUM_THREADS").is_none().then(idle_cores).flatten());
+    let by_load =
+        if cli.threads.is_none() && std::env::var_os("RAYON_NUM_THREADS").is_none() { idle_cores() } else { None };
+    let threads = cli.threads.or(by_load);
     if let Some(n) = threads {
         if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
             eprintln!("error: cannot start {n} worker threads: {e}");
@@ -75,6 +77,12 @@ fn main() -> ExitCode {
     // Notes of the solvers (the factor's size before factorising) go with the stage timings.
     if !matches!(&cli.command, Command::Run(a) if a.quiet) {
         stickslip_fe::memory::set_notes(|text| eprintln!("{text}"));
+        // The thread count changes the round-off, which can move a friction branch's points:
+        // when the load chose fewer threads than cores, say how to repeat this run exactly.
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        if let Some(n) = by_load.filter(|&n| n < cores) {
+            eprintln!("worker threads: {n} of {cores} cores, the others busy (load average); --threads {n} repeats this run's round-off");
+        }
     }
     let result = match cli.command {
         Command::Run(a) => commands::run::main(a),
