@@ -55,11 +55,7 @@ impl Problem for FrequencySweep<'_, '_> {
     }
 
     fn complete_jacobian(&mut self, (dx, dl): (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
-        if self.hbm.complete_jacobian(dx, Some(dl), None) {
-            Ok(())
-        } else {
-            Err(ProblemError::new("no residual evaluation of sliders to complete to a Jacobian"))
-        }
+        completed(self.hbm.complete_jacobian(dx, Some(dl), None))
     }
 
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
@@ -108,11 +104,7 @@ impl Problem for LevelSweep<'_, '_> {
     }
 
     fn complete_jacobian(&mut self, (dx, dl): (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
-        if self.hbm.complete_jacobian(dx, None, Some(dl)) {
-            Ok(())
-        } else {
-            Err(ProblemError::new("no residual evaluation of sliders to complete to a Jacobian"))
-        }
+        completed(self.hbm.complete_jacobian(dx, None, Some(dl)))
     }
 
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
@@ -142,6 +134,15 @@ impl FactoredJacobian for LevelSweep<'_, '_> {
 
 /// An element that fails on a trial motion (no periodic regime, a non-finite force) rejects
 /// the step, which is retried shorter; any other error ends the branch.
+/// [`CondensedHbm::complete_jacobian`]'s outcome for the continuation.
+fn completed(done: bool) -> Result<(), ProblemError> {
+    if done {
+        Ok(())
+    } else {
+        Err(ProblemError::new("no residual evaluation of sliders to complete to a Jacobian"))
+    }
+}
+
 fn problem_error(e: HbmError) -> ProblemError {
     match e {
         HbmError::Aft(_) => ProblemError::at_trial_iterate(e.to_string()),
