@@ -75,8 +75,8 @@ fn the_peak_of_a_linear_oscillator_is_located_at_its_closed_form() {
     assert!((sampled.lambda - w_peak).abs() > 1e-5 * w_peak, "the default steps happen to hit the peak");
     assert!((found.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", found.lambda);
     assert!((found.value - a_peak).abs() < 1e-12 * a_peak, "{} vs {a_peak}", found.value);
-    // Three points of the bracket, the 65-point scan and a few Brent steps.
-    assert!(found.solves < 100, "{} solves", found.solves);
+    // The middle point, the scan (16 lattice points or more) and Brent's steps.
+    assert!(found.solves < 50, "{} solves", found.solves);
 }
 
 #[test]
@@ -137,8 +137,13 @@ fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds
     assert!((found[0].lambda - found[1].lambda).abs() > 1e-4 * wn);
     // Each later search solved only the lattice points outside the earlier windows and its own
     // Brent steps: the power's window is the amplitude's, so its search solved only Brent's
-    // steps (to 1e-9, at most ~20), against a whole scan alone.
+    // steps (to 1e-9, at most ~20), against a whole scan (16 points or more) besides alone.
     assert_eq!(found[0].solves, alone[0].solves);
     assert!(found[1].solves < alone[1].solves, "{} solves shared, {} alone", found[1].solves, alone[1].solves);
-    assert!(found[2].solves <= 20 && alone[2].solves > 60, "{} shared, {} alone", found[2].solves, alone[2].solves);
+    assert!(
+        found[2].solves <= 20 && alone[2].solves >= found[2].solves + 16,
+        "{} shared, {} alone",
+        found[2].solves,
+        alone[2].solves
+    );
 }

@@ -36,12 +36,19 @@ pub struct Extremum {
 const GOLDEN: f64 = 0.381_966_011_250_105_1;
 /// Newton iterations allowed for one point of the bracket.
 const MAX_ITERATIONS: usize = 30;
-/// Points scanned around the envelope's vertex before the local refinement, and the half-width
-/// of that window on the bracket's chord (1 = the whole bracket, two continuation steps): the
-/// scan's spacing, 0.3/64 ≈ 0.005 of the bracket, is below the width of one arc of a friction
-/// peak at the default steps (see below).
-const SCAN: usize = 64;
+/// Spacing of the scan on the bracket's chord (1 = the whole bracket, two continuation steps),
+/// and the half-width of the scanned window beyond the envelope's vertex and the middle point.
+/// The arcs of a friction peak (see [`Bracket::maximise`]) are ~0.1 of the bracket wide at the
+/// default steps (Table 6, 300 samples), so the lattice puts several points on each; Harmony's
+/// four joints make some narrower, and its highest arc lay up to 0.15 from the vertex (a
+/// narrower window missed it by 1e-4, a coarser lattice by 2e-5). The window is widened while
+/// the best point is at one of its ends.
+const SCAN_SPACING: f64 = 0.02;
 const WINDOW: f64 = 0.15;
+/// The scanned arcs that are maximised: those whose best scanned point is within this fraction
+/// of the best. The tops of a friction peak's arcs differ by 1e-5 to 1e-4 near the maximum, a
+/// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
+const CANDIDATE: f64 = 2e-4;
 
 /// Locate the maximum of `quantity(problem, x, λ)` along the branch of `problem` between
 /// `before` and `after`, given `middle`, a converged point between them where the quantity is
@@ -59,7 +66,7 @@ pub fn maximise_along<P: Problem>(
 /// The branch between three of its points, where several quantities may be maximised in turn
 /// ([`Bracket::maximise`]): the outputs of a structure that peak between the same two points
 /// share the points solved there. The scan of each maximum lies on one lattice of `s` (spacing
-/// `2 WINDOW / SCAN`), so the scans of quantities whose vertices are near each other solve
+/// `SCAN_SPACING`), so the scans of quantities whose vertices are near each other solve
 /// mostly the same points, once.
 pub struct Bracket {
     z0: Vec<f64>,
@@ -144,6 +151,13 @@ impl Bracket {
         let n = self.path.n;
         let (x_scale, lambda_scale, sm) = (self.path.x_scale, self.path.lambda_scale, self.sm);
         let solved_before = self.solves;
+        // At the bracket's ends, the continuation's points as they are: they only place the
+        // envelope's vertex.
+        let mut at_end = |z: &[f64]| {
+            let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
+            quantity(problem, &x, z[n] * lambda_scale)
+        };
+        let (f0, f1) = (at_end(&self.z0)?, at_end(&self.z1)?);
         // The quantity at s; the best point so far is kept.
         let mut best = (f64::NEG_INFINITY, self.zm.clone());
         let mut value_at = |bracket: &mut Bracket, problem: &mut P, s: f64| -> Result<f64, ProblemError> {
@@ -160,12 +174,12 @@ impl Bracket {
         };
 
         // A friction peak is a chain of smooth arcs joined at corners: the slip instants move
-        // in steps of one time sample as the phase turns through the resonance, every few
-        // hundredths of a hertz for 300 samples. Each arc has its own local maximum, within
-        // ~1e-5 of the others near the top. The three sampled points place the envelope's
-        // vertex (a parabola through them); a dense scan around it finds the highest arc,
-        // Brent's method then its maximum.
-        let (f0, fm, f1) = (value_at(self, problem, 0.0)?, value_at(self, problem, sm)?, value_at(self, problem, 1.0)?);
+        // in steps of one time sample as the phase turns through the resonance. Each arc has
+        // its own local maximum, within ~1e-5 of the others near the top. The three sampled
+        // points place the envelope's vertex (a parabola through them); a scan on a lattice
+        // finer than the arcs around it finds the arcs near the top, and Brent's method the
+        // maximum of each arc whose scanned best is near the best (the highest is kept).
+        let fm = value_at(self, problem, sm)?;
         // Vertex of the parabola through (0, f0), (sm, fm), (1, f1).
         let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
         let denominator = d0 - d1;
@@ -174,24 +188,56 @@ impl Bracket {
         } else {
             sm
         };
+        let mut samples: Vec<(f64, f64)> = vec![(0.0, f64::NEG_INFINITY), (sm, fm), (1.0, f64::NEG_INFINITY)];
+        let lattice = |k: i64| k as f64 * SCAN_SPACING;
         // The window spans the vertex and the middle point: on a friction peak, whose top is a
         // chain of arcs rather than a parabola, the highest arc may lie near either.
-        let spacing = 2.0 * WINDOW / SCAN as f64;
-        let first = ((vertex.min(sm) - WINDOW) / spacing).ceil() as i64;
-        let last = ((vertex.max(sm) + WINDOW) / spacing).floor() as i64;
-        let mut samples: Vec<(f64, f64)> = vec![(sm, fm)];
+        let (mut first, mut last) = (
+            ((vertex.min(sm) - WINDOW) / SCAN_SPACING).ceil() as i64,
+            ((vertex.max(sm) + WINDOW) / SCAN_SPACING).floor() as i64,
+        );
         for k in first..=last {
-            let s = k as f64 * spacing;
-            if s > 0.0 && s < 1.0 {
-                samples.push((s, value_at(self, problem, s)?));
+            if lattice(k) > 0.0 && lattice(k) < 1.0 {
+                samples.push((lattice(k), value_at(self, problem, lattice(k))?));
             }
         }
-        samples.extend([(0.0, f64::NEG_INFINITY), (1.0, f64::NEG_INFINITY)]);
-        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let j =
-            (1..samples.len() - 1).max_by(|&a, &b| samples[a].1.total_cmp(&samples[b].1)).expect("interior samples");
-        if samples[j].1.is_finite() {
-            brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| value_at(self, problem, s))?;
+        // Widened while the best scanned point is at an end of the window: the vertex of the
+        // sampled parabola was off (a peak far from symmetric).
+        loop {
+            samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let best = (1..samples.len() - 1).max_by(|&a, &b| samples[a].1.total_cmp(&samples[b].1)).expect("interior");
+            let k = if samples[best].0 == lattice(first) && lattice(first - 1) > 0.0 {
+                first -= 1;
+                first
+            } else if samples[best].0 == lattice(last) && lattice(last + 1) < 1.0 {
+                last += 1;
+                last
+            } else {
+                break;
+            };
+            samples.push((lattice(k), value_at(self, problem, lattice(k))?));
+        }
+        let top = samples.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        if top.is_finite() {
+            // The arcs near the top: scanned points higher than their scanned neighbours (an
+            // end of the window is not, the bracket's ends are not scanned), within CANDIDATE
+            // of the best, highest first.
+            let mut candidates: Vec<usize> = (1..samples.len() - 1)
+                .filter(|&j| {
+                    let (before, here, after) = (samples[j - 1].1, samples[j].1, samples[j + 1].1);
+                    before.is_finite()
+                        && after.is_finite()
+                        && here >= before
+                        && here >= after
+                        && here >= top - CANDIDATE * top.abs()
+                })
+                .collect();
+            candidates.sort_by(|&a, &b| samples[b].1.total_cmp(&samples[a].1));
+            for j in candidates {
+                brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| {
+                    value_at(self, problem, s)
+                })?;
+            }
         }
         let (value, best_z) = best;
         if !value.is_finite() {
