@@ -119,7 +119,8 @@ pub fn continuation_options(study: &Study) -> Options {
 }
 
 /// Sweep the band of `study` at force `level` (N). Every converged point is kept, whatever
-/// ends the branch; `observer` sees each point as it is accepted.
+/// ends the branch; `observer` sees each point as it is accepted. For several levels of one
+/// study, [`LevelSweeper`] sets the model's linear part up once.
 pub fn run_level<O: Observer + ?Sized>(
     study: &Study,
     model: &NonlinearModel,
@@ -128,77 +129,105 @@ pub fn run_level<O: Observer + ?Sized>(
     level: f64,
     observer: &mut O,
 ) -> Result<LevelRun, SweepError> {
-    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
-    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings)?;
-    let options = continuation_options(study);
-    let branch: Branch = sweep_frequency(
-        &mut hbm,
-        level,
-        TWO_PI * study.sweep.start_hz,
-        TWO_PI * study.sweep.end_hz,
-        &options,
-        observer,
-    )?;
-    let selectors = selectors(outputs);
-    let mut points = Vec::with_capacity(branch.points.len());
-    let hill = match study.hbm.stability {
-        true => {
-            let omega_max = TWO_PI * study.sweep.start_hz.max(study.sweep.end_hz);
-            let settings = HillSettings::for_band(study.hbm.harmonics, omega_max);
-            Some(Hill::new(hbm.receptance(), settings).map_err(BranchStabilityError::from)?)
-        }
-        false => None,
-    };
-    let mut stabilities = Vec::new();
-    for (index, p) in branch.points.iter().enumerate() {
-        let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, &selectors)?;
-        // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
-        let residual = p.residual_norm / branch.residual_scale;
-        let mut point = record(&result, p.iterations, residual, study.output_options.time_data.keeps(index));
-        if let Some(hill) = &hill {
-            let stability = stability_at(&mut hbm, hill, &p.x, p.lambda)?;
-            let leading = stability.leading();
-            point.stability = Some(PointStability {
-                stable: is_stable(&stability, p.lambda),
-                exponent_re: leading.re,
-                exponent_im: leading.im,
-            });
-            stabilities.push(stability);
-        }
-        points.push(point);
+    LevelSweeper::new(study, model, excitation, outputs)?.run(level, observer)
+}
+
+/// What the force levels of a study share, set up once: the condensed balance's linear part
+/// (the receptance, from the model's modes), Hill's setup when stability is asked, the
+/// outputs. Each level sweeps with a balance of its own that shares the linear part
+/// ([`CondensedHbm::share_linear_part`]), so levels run in parallel on one sweeper.
+pub struct LevelSweeper<'a> {
+    study: &'a Study,
+    hbm: CondensedHbm<'a>,
+    hill: Option<Hill>,
+    selectors: Vec<OutputSelector>,
+}
+
+impl<'a> LevelSweeper<'a> {
+    pub fn new(
+        study: &'a Study,
+        model: &'a NonlinearModel,
+        excitation: &Excitation,
+        outputs: &[OutputSpec],
+    ) -> Result<Self, SweepError> {
+        let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+        let hbm = CondensedHbm::new(model, &excitation.pattern, settings)?;
+        let hill = match study.hbm.stability {
+            true => {
+                let omega_max = TWO_PI * study.sweep.start_hz.max(study.sweep.end_hz);
+                let settings = HillSettings::for_band(study.hbm.harmonics, omega_max);
+                Some(Hill::new(hbm.receptance(), settings).map_err(BranchStabilityError::from)?)
+            }
+            false => None,
+        };
+        Ok(LevelSweeper { study, hbm, hill, selectors: selectors(outputs) })
     }
-    let peaks = locate_peaks(&mut hbm, &branch, level, &selectors, &points);
-    let bifurcations = match &hill {
-        Some(hill) => bifurcations(&mut hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
-            .into_iter()
-            .map(|b| -> Result<BifurcationRecord, SweepError> {
-                let result = evaluate_point(&mut hbm, &b.x, b.omega, level, &selectors)?;
-                Ok(BifurcationRecord {
-                    level_n: level,
-                    kind: b.kind.name().to_string(),
-                    frequency_hz: b.omega / TWO_PI,
-                    amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
-                    exponent_im: b.exponent.im,
-                    located: b.located,
+
+    /// Sweep the band at force `level` (N), as [`run_level`].
+    pub fn run<O: Observer + ?Sized>(&self, level: f64, observer: &mut O) -> Result<LevelRun, SweepError> {
+        let (study, hill, selectors) = (self.study, self.hill.as_ref(), self.selectors.as_slice());
+        let mut hbm = self.hbm.share_linear_part();
+        let options = continuation_options(study);
+        let branch: Branch = sweep_frequency(
+            &mut hbm,
+            level,
+            TWO_PI * study.sweep.start_hz,
+            TWO_PI * study.sweep.end_hz,
+            &options,
+            observer,
+        )?;
+        let mut points = Vec::with_capacity(branch.points.len());
+        let mut stabilities = Vec::new();
+        for (index, p) in branch.points.iter().enumerate() {
+            let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, selectors)?;
+            // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
+            let residual = p.residual_norm / branch.residual_scale;
+            let mut point = record(&result, p.iterations, residual, study.output_options.time_data.keeps(index));
+            if let Some(hill) = hill {
+                let stability = stability_at(&mut hbm, hill, &p.x, p.lambda)?;
+                let leading = stability.leading();
+                point.stability = Some(PointStability {
+                    stable: is_stable(&stability, p.lambda),
+                    exponent_re: leading.re,
+                    exponent_im: leading.im,
+                });
+                stabilities.push(stability);
+            }
+            points.push(point);
+        }
+        let peaks = locate_peaks(&mut hbm, &branch, level, selectors, &points);
+        let bifurcations = match hill {
+            Some(hill) => bifurcations(&mut hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
+                .into_iter()
+                .map(|b| -> Result<BifurcationRecord, SweepError> {
+                    let result = evaluate_point(&mut hbm, &b.x, b.omega, level, selectors)?;
+                    Ok(BifurcationRecord {
+                        level_n: level,
+                        kind: b.kind.name().to_string(),
+                        frequency_hz: b.omega / TWO_PI,
+                        amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
+                        exponent_im: b.exponent.im,
+                        located: b.located,
+                    })
                 })
-            })
-            .collect::<Result<Vec<_>, _>>()?,
-        None => Vec::new(),
-    };
-    let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
-        format!(
-            "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
-            (p.lambda / TWO_PI - study.sweep.start_hz).abs(),
-            p.lambda / TWO_PI
-        )
-    });
-    Ok(LevelRun {
-        note,
-        newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
-        evaluations: branch.calls.residuals,
-        result: LevelResult { level_n: level, points, peaks, bifurcations },
-        termination: branch.termination,
-    })
+                .collect::<Result<Vec<_>, _>>()?,
+            None => Vec::new(),
+        };
+        let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
+            format!(
+                "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
+                (p.lambda / TWO_PI - study.sweep.start_hz).abs(),
+                p.lambda / TWO_PI
+            )
+        });
+        Ok(LevelRun {
+            note,
+            newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
+            evaluations: branch.calls.residuals,
+            result: LevelResult { level_n: level, points, peaks, bifurcations },
+            termination: branch.termination,
+        })
+    }
 }
 
 /// Relative precision of a located peak on its bracket's chord (two continuation steps): far

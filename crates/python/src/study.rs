@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_core::timesim::{steady_state, SteadyStateOptions};
-use stickslip_io::analysis::{describe_termination, run_level, LevelRun};
+use stickslip_io::analysis::{describe_termination, LevelRun, LevelSweeper};
 use stickslip_io::output::{frf_columns, frf_row, LevelResult, PointRecord};
 use stickslip_io::study::Study as IoStudy;
 
@@ -88,6 +88,8 @@ impl PyStudy {
         let runs = py.detach(|| {
             guarded(|| {
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
+                let sweeper = LevelSweeper::new(study, &model, &excitation, &outputs)
+                    .map_err(|e| SolveError::new_err(format!("setting up the harmonic balance: {}", chain(&e))))?;
                 // Levels are independent sweeps: solved in parallel on the thread pool, as the
                 // command line does, and returned in the study's order.
                 excitation
@@ -105,7 +107,8 @@ impl PyStudy {
                                 *failed = Some(e);
                             }
                         };
-                        run_level(study, &model, &excitation, &outputs, level, &mut observer)
+                        sweeper
+                            .run(level, &mut observer)
                             .map_err(|e| SolveError::new_err(format!("level {level} N: {}", chain(&e))))
                     })
                     .collect::<PyResult<Vec<LevelRun>>>()
@@ -139,6 +142,8 @@ impl PyStudy {
         let solved = py.detach(|| {
             guarded(|| {
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
+                let sweeper = LevelSweeper::new(study, &model, &excitation, &outputs)
+                    .map_err(|e| SolveError::new_err(format!("setting up the harmonic balance: {}", chain(&e))))?;
                 let mut o =
                     SteadyStateOptions::new(frequency_hz, excitation.pattern.iter().map(|p| p * level_n).collect());
                 o.steps_per_period = steps_per_period;

@@ -6,7 +6,7 @@ use anyhow::Context;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
-use stickslip_io::analysis::{describe_termination, run_grid, run_level, run_snapshot, LevelRun};
+use stickslip_io::analysis::{describe_termination, run_grid, run_snapshot, LevelRun, LevelSweeper};
 use stickslip_io::output::{replace_previous_run, time_data_files, write_frf_csv, write_results, write_snapshots};
 use stickslip_io::report::write_report;
 use stickslip_io::study::Study;
@@ -63,6 +63,9 @@ pub fn main(args: Args) -> anyhow::Result<()> {
         .progress_chars("=> ");
     let (start_hz, end_hz) = (study.sweep.start_hz, study.sweep.end_hz);
     let started = Instant::now();
+    // The model's linear part (its modes) once, shared by the levels.
+    let sweeper =
+        LevelSweeper::new(&study, &model, &excitation, &outputs).context("setting up the harmonic balance")?;
     let runs: Vec<anyhow::Result<(LevelRun, f64)>> = excitation
         .levels_n
         .par_iter()
@@ -75,8 +78,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 bar.set_position((done * 1000.0) as u64);
                 bar.set_message(format!("{:.2} Hz", p.lambda / (2.0 * std::f64::consts::PI)));
             };
-            let run = run_level(&study, &model, &excitation, &outputs, level, &mut observer)
-                .with_context(|| format!("level {level} N"))?;
+            let run = sweeper.run(level, &mut observer).with_context(|| format!("level {level} N"))?;
             let secs = level_started.elapsed().as_secs_f64();
             if let Some(note) = &run.note {
                 bars.suspend(|| eprintln!("level {level} N: {note}"));

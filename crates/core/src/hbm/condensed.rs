@@ -24,6 +24,8 @@ use faer::{c64, Mat, MatMut};
 use super::element_aft::{AftError, ElementAft};
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
+use std::sync::Arc;
+
 use super::receptance::{HarmonicReceptance, Receptance};
 use super::structured::StructuredJacobian;
 use crate::model::{ModelError, NonlinearModel};
@@ -69,7 +71,9 @@ pub const FACTOR_BY_STRUCTURE_FROM: usize = 500;
 pub struct CondensedHbm<'m> {
     model: &'m NonlinearModel,
     plan: AftPlan,
-    receptance: Receptance,
+    /// The linear part, shared by the balances of one model and excitation
+    /// ([`Self::share_linear_part`]).
+    receptance: Arc<Receptance>,
     force: Vec<f64>,
     q: usize,
     /// The nonlinear part: the joints' forces by AFT.
@@ -102,10 +106,29 @@ impl<'m> CondensedHbm<'m> {
         if model.elements.is_empty() {
             return Err(HbmError::NoElements);
         }
-        let plan = AftPlan::new(settings.harmonics, settings.samples)?;
         let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
-        let receptance = Receptance::new(&model.linear, &directions, force)?;
-        let q = directions.len();
+        let receptance = Arc::new(Receptance::new(&model.linear, &directions, force)?);
+        Self::with_receptance(model, force, settings, receptance)
+    }
+
+    /// A balance of the same model, excitation and settings that shares this one's linear part
+    /// (the receptance: the model's modes, the costly part of [`Self::new`]) and has state of
+    /// its own: what the force levels of a study, swept one per thread, have in common. It
+    /// evaluates exactly as a balance made by [`Self::new`].
+    pub fn share_linear_part(&self) -> Self {
+        let settings = HbmSettings { harmonics: self.plan.n_harmonics(), samples: self.plan.n_samples() };
+        Self::with_receptance(self.model, &self.force, settings, Arc::clone(&self.receptance))
+            .expect("the settings of a balance that was set up")
+    }
+
+    fn with_receptance(
+        model: &'m NonlinearModel,
+        force: &[f64],
+        settings: HbmSettings,
+        receptance: Arc<Receptance>,
+    ) -> Result<Self, HbmError> {
+        let plan = AftPlan::new(settings.harmonics, settings.samples)?;
+        let q = receptance.n_directions();
         let joints = JointForces::new(model, &plan);
         // Static receptance H(0) = Vᵀ K⁻¹ V (real).
         let mut h = HarmonicReceptance::new(q);

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 pub use design::{design, Design, Values, Vary};
 pub use keys::{KeyPath, NumberKind};
 
-use crate::analysis::{describe_termination, run_level};
+use crate::analysis::{describe_termination, LevelSweeper};
 use crate::output::LevelResult;
 use crate::study::{LinearBase, Study, StudyError};
 
@@ -292,8 +292,11 @@ impl<'a> SampleRunner<'a> {
         };
         let mut rows = Vec::new();
         let mut levels = Vec::new();
+        let sweeper = LevelSweeper::new(&study, &model, &excitation, &outputs)
+            .map_err(|e| ParamError::Design(format!("setting up the harmonic balance: {e}")))?;
         for &level in &excitation.levels_n {
-            let run = run_level(&study, &model, &excitation, &outputs, level, &mut |_: &_, _: f64| {})
+            let run = sweeper
+                .run(level, &mut |_: &_, _: f64| {})
                 .map_err(|e| ParamError::Design(format!("level {level} N: {e}")))?;
             rows.push(summarise(&run.result, which, run.is_complete(), describe_termination(&run.termination)));
             if curves {
