@@ -60,11 +60,19 @@ struct Line {
     nan_on_call: Option<usize>,
     nan_above: f64,
     error_above: f64,
+    /// NaN residuals for λ strictly inside.
+    hole: (f64, f64),
 }
 
 impl Line {
     fn new() -> Self {
-        Line { calls: 0, nan_on_call: None, nan_above: f64::INFINITY, error_above: f64::INFINITY }
+        Line {
+            calls: 0,
+            nan_on_call: None,
+            nan_above: f64::INFINITY,
+            error_above: f64::INFINITY,
+            hole: (f64::INFINITY, f64::INFINITY),
+        }
     }
 }
 
@@ -83,8 +91,12 @@ impl Problem for Line {
         if lambda > self.error_above {
             return Err(ProblemError::new(format!("no solution model beyond λ = {}", self.error_above)));
         }
-        residual[0] =
-            if Some(self.calls) == self.nan_on_call || lambda > self.nan_above { f64::NAN } else { x[0] - lambda };
+        let in_hole = lambda > self.hole.0 && lambda < self.hole.1;
+        residual[0] = if Some(self.calls) == self.nan_on_call || lambda > self.nan_above || in_hole {
+            f64::NAN
+        } else {
+            x[0] - lambda
+        };
         if let Some((mut jx, dl)) = jacobian {
             jx[(0, 0)] = 1.0;
             dl[0] = -1.0;
@@ -181,6 +193,30 @@ fn a_failed_correction_halves_the_step_and_the_next_step_does_not_grow() {
 }
 
 #[test]
+fn a_point_where_no_step_converges_is_leapt_over() {
+    // NaN residuals on a hole 3e-5 wide around where the first step lands: the steps halve
+    // towards it, down to min_step = 1e-6 in front of it, then leaps of 4, 16, 64... times the
+    // smallest step try beyond it, and one lands past it.
+    let options = Options { initial_step: 1e-2, min_step: 1e-6, ..Options::default() };
+    let first_step = run(&mut Line::new(), 0.0, 0.0, 1.0, &options).points[1].lambda;
+    let hole = (first_step - 1.5e-5, first_step + 1.5e-5);
+    let branch = run(&mut Line { hole, ..Line::new() }, 0.0, 0.0, 1.0, &options);
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    assert!(branch.points.iter().all(|p| !(p.lambda > hole.0 && p.lambda < hole.1)));
+    let i = branch.points.iter().position(|p| p.lambda >= hole.1).unwrap();
+    let (before, over) = (&branch.points[i - 1], &branch.points[i]);
+    // In front of the hole the last accepted step was within a few min_steps of it (the next,
+    // at most twice as long, failed); the leap is over 3e-5 long, at most 4⁶ times 2e-6.
+    assert!(hole.0 - before.lambda < 4e-6, "approached to {} of the hole", hole.0 - before.lambda);
+    assert!(over.rejected > 1 && over.step >= 3e-5 && over.step <= 4096.0 * 2e-6, "{over:?}");
+    assert!(branch.points.iter().all(|p| (p.x[0] - p.lambda).abs() <= 1e-10));
+    // Without leaps the branch stops in front of the hole.
+    let strict = Options { leaps: 0, ..options };
+    let branch = run(&mut Line { hole, ..Line::new() }, 0.0, 0.0, 1.0, &strict);
+    assert!(matches!(branch.termination, TerminationReason::StepTooSmall { leaps: 0, .. }));
+}
+
+#[test]
 fn steps_halve_down_to_min_step_before_a_wall() {
     // NaN residuals beyond λ = 0.5: every step that crosses it fails.
     let options = Options { initial_step: 1e-2, min_step: 1e-6, ..Options::default() };
@@ -190,19 +226,26 @@ fn steps_halve_down_to_min_step_before_a_wall() {
     let last = branch.points.last().unwrap();
     assert!(last.lambda <= 0.5);
     let planned = if last.rejected == 0 { (last.step * options.growth).min(options.max_step) } else { last.step };
-    // Halvings until the step falls below min_step.
-    let mut expected_attempts = 0;
+    // Halvings while the step stays at or above min_step, then leaps of 4 times the last from
+    // the smallest, up to max_step or `leaps` of them: all fail beyond the wall.
+    let mut expected_attempts = 1;
     let mut h = planned;
-    while h >= options.min_step {
+    while 0.5 * h >= options.min_step {
         h *= 0.5;
         expected_attempts += 1;
     }
+    let mut expected_leaps = 0;
+    while expected_leaps < options.leaps && h < options.max_step {
+        h = (4.0 * h).min(options.max_step);
+        expected_leaps += 1;
+    }
     match branch.termination {
-        TerminationReason::StepTooSmall { lambda, attempts, residual_norm, .. } => {
+        TerminationReason::StepTooSmall { lambda, attempts, leaps, residual_norm, .. } => {
             let message = branch.termination.to_string();
             assert!(message.contains(&format!("{attempts} steps tried")), "{message}");
             assert_eq!(lambda, last.lambda);
-            assert_eq!(attempts, expected_attempts);
+            assert_eq!(leaps, expected_leaps);
+            assert_eq!(attempts, expected_attempts + expected_leaps);
             assert!(residual_norm.is_nan());
         }
         other => panic!("expected StepTooSmall, got {other:?}"),
@@ -403,7 +446,7 @@ fn a_corner_of_a_non_smooth_branch_is_passed_after_corner_after_halvings() {
         );
 
         // Without the rule the steps shrink to nothing at the corner.
-        let strict = Options { predictor, corner_after: usize::MAX, ..Options::default() };
+        let strict = Options { predictor, corner_after: usize::MAX, leaps: 0, ..Options::default() };
         let branch = run(&mut Corner, 0.0, 0.0, 1.0, &strict);
         match branch.termination {
             TerminationReason::StepTooSmall { lambda, .. } => {

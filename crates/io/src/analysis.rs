@@ -451,7 +451,7 @@ pub fn describe_termination(t: &TerminationReason) -> String {
             "no convergence at the first point, {:.3} Hz, after {iterations} Newton iterations (residual {residual_norm:.3e}): start the band where the response is closer to linear, or use more harmonics",
             lambda / TWO_PI
         ),
-        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, iterations } => {
+        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations } => {
             let advice = match rejection {
                 Rejection::NewtonCycle => {
                     "; with a stiff friction joint this is a time sample switching between stick and slip: try more [harmonic_balance] samples (e.g. 512)"
@@ -459,7 +459,7 @@ pub fn describe_termination(t: &TerminationReason) -> String {
                 _ => "; try a smaller [continuation] min_step_hz, more [harmonic_balance] samples or another predictor",
             };
             format!(
-                "stopped after {:.3} Hz: {attempts} ever smaller steps failed ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}{advice}",
+                "stopped after {:.3} Hz: {attempts} steps failed, ever smaller down to [continuation] min_step_hz, then {leaps} leaps ever longer ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}{advice}",
                 lambda / TWO_PI
             )
         }

@@ -61,11 +61,16 @@
 //!   proportional to the step, whereas a jump stays far however small the step).
 //! - **ADAPT STEP**: a rejection halves `h` and retries from `z_i`; an acceptance after at most
 //!   `easy_iterations` Newton iterations multiplies `h` by `growth` (not right after a
-//!   rejection); `h` stays within `[min_step, max_step]`.
+//!   rejection); `h` stays within `[min_step, max_step]`. Where every step down to `min_step`
+//!   fails, the point ahead is one Newton cannot converge at however close it starts (a
+//!   non-smooth, singular residual: several identical joints switching between stick and slip
+//!   at one time sample together); up to `leaps` steps, each 4 times the last from the
+//!   smallest, try to land beyond it, where the branch is regular again. A leap is checked as
+//!   any step.
 //! - **TERMINATE**: the branch ends as a value ([`TerminationReason`]): when a point passes
 //!   `λ_end` (or, after a fold, goes back past `λ_start`) the last point is replaced by a Newton
 //!   solve at exactly that `λ` from the interpolated guess; when `max_points` are stored; when
-//!   `h` falls below `min_step`; when the problem returns an error. Every converged point before
+//!   `h` falls below `min_step` and the leaps failed; when the problem returns an error. Every converged point before
 //!   is kept.
 //!
 //! Progress goes to an [`Observer`]; the library never prints. Each point carries its call
@@ -255,6 +260,9 @@ pub struct Options {
     pub atol: f64,
     /// Number of points after which the branch stops.
     pub max_points: usize,
+    /// Leaps tried once the steps have halved down to `min_step`, each 4 times the last,
+    /// before the branch stops (see ADAPT STEP).
+    pub leaps: usize,
 }
 
 impl Default for Options {
@@ -273,6 +281,7 @@ impl Default for Options {
             rtol: 1e-10,
             atol: 1e-14,
             max_points: 10_000,
+            leaps: 10,
         }
     }
 }
@@ -333,8 +342,10 @@ pub enum TerminationReason {
         lambda: f64,
         /// Residual norm at the end of the last failed correction.
         residual_norm: f64,
-        /// Steps tried (each half the previous).
+        /// Steps tried (each half the previous, then the leaps).
         attempts: usize,
+        /// Of those, leaps beyond the smallest step (each 4 times the last).
+        leaps: usize,
         /// Newton iterations spent on them.
         iterations: usize,
     },
@@ -359,12 +370,14 @@ impl std::fmt::Display for TerminationReason {
                 "no solution found at the start λ = {lambda}: Newton from the initial guess ended at residual \
                  {residual_norm:.3e} after {iterations} iterations"
             ),
-            TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, iterations } => write!(
-                f,
-                "no step accepted after the point at λ = {lambda}: {attempts} steps tried, each half the previous \
-                 ({iterations} Newton iterations), down to the minimum step; the last was rejected because \
-                 {rejection} (residual {residual_norm:.3e})"
-            ),
+            TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations } => {
+                write!(
+                    f,
+                    "no step accepted after the point at λ = {lambda}: {attempts} steps tried, each half the previous \
+                 down to the minimum step, then {leaps} leaps each 4 times the last ({iterations} Newton \
+                 iterations); the last was rejected because {rejection} (residual {residual_norm:.3e})"
+                )
+            }
             TerminationReason::ProblemError { lambda, last_lambda, error } => match last_lambda {
                 Some(last) => {
                     write!(f, "the problem failed at λ = {lambda} (last converged point at λ = {last}): {error}")

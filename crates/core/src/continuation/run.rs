@@ -118,10 +118,13 @@ struct StepControl {
     just_rejected: bool,
     attempts: usize,
     failed_iterations: usize,
+    /// Leaps tried since the steps reached `min_step`.
+    leaps: usize,
 }
 
 impl StepControl {
-    /// ADAPT STEP after a rejection: halve. Returns the termination when below `min_step`.
+    /// ADAPT STEP after a rejection: halve down to `min_step`, then leap (each 4 times the
+    /// last, at most `max_step`). Returns the termination when the leaps are spent.
     fn reject(
         &mut self,
         rejection: Rejection,
@@ -133,12 +136,21 @@ impl StepControl {
         self.failed_iterations += iterations;
         self.attempts += 1;
         self.just_rejected = true;
-        self.step *= 0.5;
-        (self.step < options.min_step).then_some(TerminationReason::StepTooSmall {
+        if self.leaps == 0 && 0.5 * self.step >= options.min_step {
+            self.step *= 0.5;
+            return None;
+        }
+        if self.leaps < options.leaps && self.step < options.max_step {
+            self.leaps += 1;
+            self.step = (4.0 * self.step).min(options.max_step);
+            return None;
+        }
+        Some(TerminationReason::StepTooSmall {
             rejection,
             lambda: last_lambda,
             residual_norm,
             attempts: self.attempts,
+            leaps: self.leaps,
             iterations: self.failed_iterations,
         })
     }
@@ -152,6 +164,7 @@ impl StepControl {
         self.just_rejected = false;
         self.attempts = 0;
         self.failed_iterations = 0;
+        self.leaps = 0;
     }
 }
 
@@ -268,8 +281,13 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         observer.on_point(&first, 0.0);
         points.push(first);
 
-        let mut control =
-            StepControl { step: options.initial_step, just_rejected: false, attempts: 0, failed_iterations: 0 };
+        let mut control = StepControl {
+            step: options.initial_step,
+            just_rejected: false,
+            attempts: 0,
+            failed_iterations: 0,
+            leaps: 0,
+        };
         let mut furthest = 0.0;
         // The tangent at the last point for a secant (or Lagrange) prediction that failed
         // twice: computed once per point, on demand.
