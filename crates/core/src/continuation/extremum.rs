@@ -45,6 +45,9 @@ const MAX_ITERATIONS: usize = 30;
 /// the best point is at one of its ends.
 const SCAN_SPACING: f64 = 0.02;
 const WINDOW: f64 = 0.15;
+/// Points within this distance of the last ones solved start from them (two lattice
+/// spacings and a half: the scan's next point, Brent's steps).
+const NEAR: f64 = 2.5 * SCAN_SPACING;
 /// The scanned arcs that are maximised: those whose best scanned point is within this fraction
 /// of the best. The tops of a friction peak's arcs differ by 1e-5 to 1e-4 near the maximum, a
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
@@ -78,8 +81,9 @@ pub struct Bracket {
     /// Points solved so far, by `s` (bit pattern: lattice points are computed identically):
     /// `None` where the branch could not be solved.
     solved: BTreeMap<u64, Option<Vec<f64>>>,
-    /// The last point solved, the guess for a near one.
+    /// The last two points solved, the guess for a near one.
     last: Option<(f64, Vec<f64>)>,
+    before_last: Option<(f64, Vec<f64>)>,
     /// Points solved on the branch so far.
     pub solves: usize,
 }
@@ -103,21 +107,29 @@ impl Bracket {
             return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
         }
         let path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
-        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), last: None, solves: 0 })
+        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), last: None, before_last: None, solves: 0 })
     }
 
-    /// The point at `s` (scaled), solved once: from the last point solved if it is near (the
-    /// scan's neighbours, one or two Newton iterations), else from the parabola through the
-    /// three points. `None` if it cannot be solved there.
+    /// The point at `s` (scaled), solved once: from the line through the last two points
+    /// solved if they are near (the scan's neighbours, Brent's steps: one or two Newton
+    /// iterations), else from the parabola through the three points. `None` if it cannot be
+    /// solved there.
     fn point<P: Problem>(&mut self, problem: &mut P, s: f64) -> Result<Option<&[f64]>, ProblemError> {
         let key = s.to_bits();
         if !self.solved.contains_key(&key) {
             let n = self.path.n;
             let mut z = vec![0.0; n + 1];
-            match &self.last {
-                Some((s_last, z_last)) if (s - s_last).abs() <= 0.02 => {
+            let near = |t: f64| (s - t).abs() <= NEAR;
+            match (&self.last, &self.before_last) {
+                (Some((s1, z1)), Some((s0, z0))) if near(*s1) && near(*s0) && s1 != s0 => {
+                    let t = (s - s1) / (s1 - s0);
                     for i in 0..=n {
-                        z[i] = z_last[i] + (s - s_last) * self.path.chord[i];
+                        z[i] = z1[i] + t * (z1[i] - z0[i]);
+                    }
+                }
+                (Some((s1, z1)), _) if near(*s1) => {
+                    for i in 0..=n {
+                        z[i] = z1[i] + (s - s1) * self.path.chord[i];
                     }
                 }
                 _ => {
@@ -132,7 +144,7 @@ impl Bracket {
             self.solves += 1;
             let solved = self.path.solve(problem, s, &mut z)?;
             if solved {
-                self.last = Some((s, z.clone()));
+                self.before_last = self.last.replace((s, z.clone()));
             }
             self.solved.insert(key, solved.then_some(z));
         }
