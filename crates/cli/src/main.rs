@@ -16,7 +16,8 @@ struct Cli {
     command: Command,
     /// Worker threads of every parallel stage (default: RAYON_NUM_THREADS if set, otherwise one
     /// per core left idle by the rest of the machine: the cores less the 1-minute load average,
-    /// rounded, at least one). Results do not depend on it beyond round-off.
+    /// rounded, or less the other tasks running now if fewer, at least one). Results do not
+    /// depend on it beyond round-off.
     #[arg(long, global = true)]
     threads: Option<usize>,
 }
@@ -49,13 +50,21 @@ enum Command {
 /// (rayon's default, one per core, then applies).
 fn idle_cores() -> Option<usize> {
     let cores = std::thread::available_parallelism().ok()?.get();
-    let load: f64 = std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()?;
-    Some(default_threads(cores, load))
+    let loadavg = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let mut fields = loadavg.split_whitespace();
+    let load: f64 = fields.next()?.parse().ok()?;
+    // The fourth field, "running/total": the tasks runnable now, this process included.
+    let running = fields.nth(2).and_then(|f| f.split('/').next()?.parse::<usize>().ok());
+    Some(default_threads(cores, load, running))
 }
 
-/// `max(1, cores − round(load))`, at most `cores`.
-fn default_threads(cores: usize, load: f64) -> usize {
-    let busy = if load.is_finite() && load > 0.0 { load.round() as usize } else { 0 };
+/// `max(1, cores − busy)`, at most `cores`, where `busy` is the rounded 1-minute load average,
+/// or fewer if fewer other tasks are runnable now (`running` counts this process): the average
+/// still counts a run that has just finished for a minute after it, which would give the next
+/// command of a workflow one thread on an idle machine.
+fn default_threads(cores: usize, load: f64, running: Option<usize>) -> usize {
+    let average = if load.is_finite() && load > 0.0 { load.round() as usize } else { 0 };
+    let busy = running.map_or(average, |r| average.min(r.saturating_sub(1)));
     cores.saturating_sub(busy).clamp(1, cores.max(1))
 }
 
@@ -110,10 +119,16 @@ mod tests {
 
     #[test]
     fn the_default_thread_count_leaves_the_busy_cores_alone() {
-        assert_eq!(default_threads(2, 0.1), 2);
-        assert_eq!(default_threads(2, 0.6), 1);
-        assert_eq!(default_threads(2, 5.3), 1);
-        assert_eq!(default_threads(8, 2.4), 6);
-        assert_eq!(default_threads(4, f64::NAN), 4);
+        assert_eq!(default_threads(2, 0.1, None), 2);
+        assert_eq!(default_threads(2, 0.6, None), 1);
+        assert_eq!(default_threads(2, 5.3, None), 1);
+        assert_eq!(default_threads(8, 2.4, None), 6);
+        assert_eq!(default_threads(4, f64::NAN, None), 4);
+        // A run that has just finished: the average is still high, only this process runs.
+        assert_eq!(default_threads(2, 0.9, Some(1)), 2);
+        // Others running now and on average: the fewer of the two.
+        assert_eq!(default_threads(2, 0.9, Some(3)), 1);
+        assert_eq!(default_threads(8, 2.4, Some(2)), 7);
+        assert_eq!(default_threads(8, 2.4, Some(6)), 6);
     }
 }
