@@ -142,8 +142,6 @@ impl PyStudy {
         let solved = py.detach(|| {
             guarded(|| {
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
-                let sweeper = LevelSweeper::new(study, &model, &excitation, &outputs)
-                    .map_err(|e| SolveError::new_err(format!("setting up the harmonic balance: {}", chain(&e))))?;
                 let mut o =
                     SteadyStateOptions::new(frequency_hz, excitation.pattern.iter().map(|p| p * level_n).collect());
                 o.steps_per_period = steps_per_period;
