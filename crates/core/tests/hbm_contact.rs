@@ -359,9 +359,8 @@ fn law_preload(law: &dyn Element) -> f64 {
 /// The 2-D contact law in continuous time for `u_t = a cos θ`, `u_n = b cos(θ − φ)`, solved
 /// event by event: stick, slip and open phases in closed form (T = T_s + k_t (u_t − u_s),
 /// T = ±μN(θ), T = 0), switches located by bisection to round-off. Independent of the AFT's
-/// sampled return mapping; the reference for variable normal load at any phase. For in-phase
-/// motion the closed forms ([`in_phase_closed_form`], the in-phase case of Yang, Chu & Menq
-/// 1998, derived below) check it in turn.
+/// sampled return mapping; the reference for variable normal load at any phase. The closed
+/// forms of [`closed_form`] (the cases of Yang, Chu & Menq 1998 derived below) check it in turn.
 struct EventReference {
     a: f64,
     b: f64,
@@ -545,37 +544,64 @@ fn variable_normal_load_matches_the_event_resolved_solution() {
     }
 }
 
-/// Closed forms of the 2-D contact under in-phase tangential and normal motion, `u_t = a cos θ`,
-/// `u_n = b cos θ` (the in-phase case of Yang, Chu & Menq, J. Sound Vib. 210, 1998), derived
-/// here for gross slip both ways. With `K = k_t a`, `P = μ N0`, `Q = μ k_n b`, the threshold is
-/// `μN(θ) = P + Q cos θ`. At θ = 0 a forward slip ends (`T = P + Q`); the contact sticks,
-/// `T = P + Q − K (1 − cos θ)`, until `T = −(P + Q cos θ)`, at `cos θ₁ = (K − 2P − Q)/(K + Q)`;
-/// it then slips backwards (`T = −(P + Q cos θ)`, the threshold falling slower than the spring
-/// would unload it) until θ = π when it stays closed (`P > Q`), or until it opens where
-/// `P + Q cos θ_o = 0` (`Q > P`, `T = 0` open until `2π − θ_o`, then, `K > Q`, a forward slip
-/// from the re-contact). Closed, at π `T = −(P − Q)` and it sticks,
-/// `T = −(P − Q) + K (1 + cos θ)`, until `T = P + Q cos θ` at `cos θ₂ = (2P − Q − K)/(K − Q)`
-/// in (π, 2π), then slips forwards to 2π. Each phase has `T = α + β cos θ`, so the energy per
-/// cycle `W = ∮ T du_t` and the first harmonic of T are sums of elementary integrals.
-/// Returns `(W, c₁, s₁)`, `T₁ = c₁ cos θ + s₁ sin θ`.
-fn in_phase_closed_form(a: f64, b: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> (f64, f64, f64) {
+/// Closed forms of the 2-D contact under `u_t = a cos θ`, `u_n = b cos(θ − φ)` with gross slip
+/// both ways (the cases of Yang, Chu & Menq, J. Sound Vib. 210, 1998, derived here): with
+/// `K = k_t a`, `P = μ N0`, `Q = μ k_n b`, the threshold is `F(θ) = P + Q cos(θ − φ)`.
+///
+/// A slip goes on while the spring would push the force beyond the moving threshold: backwards
+/// while `K sin θ + Q sin(θ − φ) = R₁ sin(θ − δ₁) > 0`, forwards while
+/// `−K sin θ + Q sin(θ − φ) = −R₂ sin(θ + δ₂) > 0`, with `R₁ e^{iδ₁} = K + Q cos φ + i Q sin φ`
+/// and `R₂ e^{iδ₂} = K − Q cos φ + i Q sin φ`. So, closed (`P > Q`):
+/// - the forward slip ends at `−δ₂` with `T_e = F(−δ₂)`; stick, `T = T_e + K (cos θ − cos δ₂)`,
+///   until `T = −F`: `R₁ cos(θ₁ − δ₁) = −P − T_e + K cos δ₂`;
+/// - backward slip, `T = −F(θ)`, until `π + δ₁`, where `T_c = −F(π + δ₁)`; stick,
+///   `T = T_c + K (cos θ + cos δ₁)`, until `T = F`: `R₂ cos(θ₂ + δ₂) = P − T_c − K cos δ₁`;
+/// - forward slip, `T = F(θ)`, until `2π − δ₂`.
+///
+/// In phase (`φ = 0`, `δ₁ = δ₂ = 0`) with partial separation (`Q > P`): the backward slip ends
+/// where the contact opens, `F(θ_o) = 0`; open (`T = 0`) until `2π − θ_o`; then (`K > Q`) a
+/// forward slip from the re-contact. Each phase has `T = α + β cos θ + γ sin θ`, so the
+/// energy per cycle `W = ∮ T du_t` and the first harmonic of T are sums of elementary
+/// integrals. Returns `(W, c₁, s₁)`, `T₁ = c₁ cos θ + s₁ sin θ`.
+fn closed_form(a: f64, b: f64, phi: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> (f64, f64, f64) {
     let (k, p, q) = (kt * a, mu * n0, mu * kn * b);
-    assert!(k > p && k > q, "gross slip both ways (k_t a > μN0, k_t a > μ k_n b)");
-    let theta1 = ((k - 2.0 * p - q) / (k + q)).acos();
-    // Phases (from, to, α, β).
-    let phases: Vec<(f64, f64, f64, f64)> = if p > q {
-        let theta2 = 2.0 * PI - ((2.0 * p - q - k) / (k - q)).acos();
-        vec![(0.0, theta1, p + q - k, k), (theta1, PI, -p, -q), (PI, theta2, -p + q + k, k), (theta2, 2.0 * PI, p, q)]
+    let (qc, qs) = (q * phi.cos(), q * phi.sin());
+    let threshold = |t: f64| p + qc * t.cos() + qs * t.sin();
+    let (r1, d1) = ((k + qc).hypot(qs), qs.atan2(k + qc));
+    let (r2, d2) = ((k - qc).hypot(qs), qs.atan2(k - qc));
+    // Phases (from, to, α, β, γ).
+    let phases: Vec<(f64, f64, f64, f64, f64)> = if p > q {
+        let t_e = threshold(-d2);
+        let c1 = (-p - t_e + k * d2.cos()) / r1;
+        let t_c = -threshold(PI + d1);
+        let c2 = (p - t_c - k * d1.cos()) / r2;
+        assert!(c1.abs() < 1.0 && c2.abs() < 1.0, "gross slip both ways");
+        let theta1 = d1 + c1.acos();
+        let theta2 = 2.0 * PI - d2 - c2.acos();
+        assert!(-d2 < theta1 && theta1 < PI + d1 && PI + d1 < theta2 && theta2 < 2.0 * PI - d2);
+        vec![
+            (-d2, theta1, t_e - k * d2.cos(), k, 0.0),
+            (theta1, PI + d1, -p, -qc, -qs),
+            (PI + d1, theta2, t_c + k * d1.cos(), k, 0.0),
+            (theta2, 2.0 * PI - d2, p, qc, qs),
+        ]
     } else {
+        assert!(phi == 0.0 && k > q && k > p, "partial separation: in phase, gross slip");
+        let theta1 = ((k - 2.0 * p - q) / (k + q)).acos();
         let theta_open = (-p / q).acos();
         assert!(theta1 < theta_open, "backward slip before the contact opens");
-        vec![(0.0, theta1, p + q - k, k), (theta1, theta_open, -p, -q), (2.0 * PI - theta_open, 2.0 * PI, p, q)]
+        vec![
+            (0.0, theta1, p + q - k, k, 0.0),
+            (theta1, theta_open, -p, -q, 0.0),
+            (2.0 * PI - theta_open, 2.0 * PI, p, q, 0.0),
+        ]
     };
     let (mut w, mut c1, mut s1) = (0.0, 0.0, 0.0);
-    for (t0, t1, alpha, beta) in phases {
-        // ∫ (α + β cos θ) sin θ dθ and ∫ (α + β cos θ) cos θ dθ over [t0, t1].
-        let sin_part = |t: f64| -alpha * t.cos() + 0.5 * beta * t.sin().powi(2);
-        let cos_part = |t: f64| alpha * t.sin() + beta * (0.5 * t + 0.25 * (2.0 * t).sin());
+    for (t0, t1, alpha, beta, gamma) in phases {
+        // ∫ (α + β cos θ + γ sin θ) sin θ dθ and ∫ (α + β cos θ + γ sin θ) cos θ dθ.
+        let (half_sin2, half_cos2) = (|t: f64| 0.5 * t.sin().powi(2), |t: f64| 0.5 * t + 0.25 * (2.0 * t).sin());
+        let sin_part = |t: f64| -alpha * t.cos() + beta * half_sin2(t) + gamma * (t - half_cos2(t));
+        let cos_part = |t: f64| alpha * t.sin() + beta * half_cos2(t) + gamma * half_sin2(t);
         let (is, ic) = (sin_part(t1) - sin_part(t0), cos_part(t1) - cos_part(t0));
         w += -a * is;
         s1 += is / PI;
@@ -585,17 +611,23 @@ fn in_phase_closed_form(a: f64, b: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> (
 }
 
 #[test]
-fn in_phase_normal_load_matches_the_closed_forms() {
+fn variable_normal_load_matches_the_closed_forms() {
     // The parameters of the event-resolved test: K = 400 N, P = μN0 = 160 N; closed with
-    // Q = μ k_n b = 80 N (θ₁ = π/2, θ₂ = 4π/3), opening with Q = 240 N (θ₁ = acos(−1/4),
-    // θ_o = acos(−2/3)).
+    // Q = μ k_n b = 80 N at four phases (in phase: θ₁ = π/2, θ₂ = 4π/3), opening in phase with
+    // Q = 240 N (θ₁ = acos(−1/4), θ_o = acos(−2/3)).
     let (kt, kn, mu, n0, a) = (1e6, 2e6, 0.4, 400.0, 4e-4);
     let law = Contact::new_2d(kt, kn, mu, n0).unwrap();
-    for (what, b) in [("closed", 1e-4), ("partial separation", 3e-4)] {
-        let (w, c1, s1) = in_phase_closed_form(a, b, kt, kn, mu, n0);
+    for (what, b, phi) in [
+        ("in phase, closed", 1e-4, 0.0),
+        ("45°, closed", 1e-4, PI / 4.0),
+        ("out of phase (90°), closed", 1e-4, PI / 2.0),
+        ("opposite phase, closed", 1e-4, PI),
+        ("in phase, partial separation", 3e-4, 0.0),
+    ] {
+        let (w, c1, s1) = closed_form(a, b, phi, kt, kn, mu, n0);
         // The event-resolved solution (switches by bisection, phases by Simpson) is the same
         // motion computed another way: equal to its quadrature's accuracy (~1e-10 measured).
-        let (w_ref, c_ref, s_ref) = EventReference { a, b, phi: 0.0, kt, kn, mu, n0 }.solve();
+        let (w_ref, c_ref, s_ref) = EventReference { a, b, phi, kt, kn, mu, n0 }.solve();
         assert!((w - w_ref).abs() < 1e-8 * w, "{what}: W {w} closed form, {w_ref} events");
         assert!((c1 - c_ref).hypot(s1 - s_ref) < 1e-8 * c1.hypot(s1), "{what}: T₁ ({c1}, {s1}), ({c_ref}, {s_ref})");
         // The AFT at 300 samples: each switch placed to within a sample, second-order errors
@@ -604,7 +636,8 @@ fn in_phase_normal_load_matches_the_closed_forms() {
         let plan = AftPlan::new(3, 300).unwrap();
         let mut u = vec![0.0; 2 * plan.n_coeffs()];
         u[cos_index(1) * 2] = a;
-        u[cos_index(1) * 2 + 1] = b;
+        u[cos_index(1) * 2 + 1] = b * phi.cos();
+        u[sin_index(1) * 2 + 1] = b * phi.sin();
         let (g, _, _) = aft(&law, &plan, &u);
         let (g_c1, g_s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
         let w_aft = PI * a * (-g_s1);
