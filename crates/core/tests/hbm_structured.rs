@@ -12,8 +12,8 @@ const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
 /// Relative difference between the structured and the dense solution of `J y = b` for a
 /// pseudo-random `b`, and the number of directions that couple harmonics.
-fn structured_against_dense(level: f64) -> (f64, usize, usize) {
-    let (model, force) = common::contact_patch(4);
+fn structured_against_dense(side: usize, level: f64) -> (f64, usize, usize) {
+    let (model, force) = common::contact_patch(side);
     let mut hbm = CondensedHbm::new(&model, &force, HbmSettings { harmonics: 5, samples: 256 }).unwrap();
     let n = hbm.dimension();
     let omega = TWO_PI * 340.0;
@@ -39,14 +39,27 @@ fn structured_against_dense(level: f64) -> (f64, usize, usize) {
 #[test]
 fn structured_solve_equals_the_dense_lu_when_part_of_the_patch_sticks() {
     // At 10 N every contact sticks: the whole Jacobian is the linear part's.
-    let (err, coupled, _) = structured_against_dense(10.0);
+    let (err, coupled, _) = structured_against_dense(4, 10.0);
     assert_eq!(coupled, 0);
     assert!(err < 1e-10, "all stuck: {err:e}");
     // At 1000 N (the linear response, 10 µm at the corner) the edges slip and lift off while
     // the centre sticks: both parts are used.
-    let (err, coupled, total) = structured_against_dense(1000.0);
+    let (err, coupled, total) = structured_against_dense(4, 1000.0);
     assert!(coupled > 0 && coupled < total, "{coupled} of {total} directions couple harmonics");
     assert!(err < 1e-10, "mixed: {err:e}");
+}
+
+/// Where most of a larger patch slips or opens, the reduced system (above 1200 unknowns) is
+/// solved by BiCGSTAB to 1e-12 relative residual: the step equals the dense LU's to what that
+/// residual and the condition number (below 1e4 here) leave, asserted 1e-8.
+#[test]
+fn the_iterative_reduced_solve_equals_the_dense_lu_where_the_patch_slips() {
+    for level in [2e4, 1e5] {
+        let (err, coupled, total) = structured_against_dense(7, level);
+        assert!(coupled * 11 > 1200, "{coupled} of {total} directions couple harmonics: not iterative");
+        assert!(err < 1e-8, "{level} N, {coupled} of {total} directions: {err:e}");
+        println!("{level} N: {coupled} of {total} directions couple harmonics, relative difference {err:.1e}");
+    }
 }
 
 /// A frequency sweep of the patch through its resonance, its Newton systems solved by structure

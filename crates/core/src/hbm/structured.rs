@@ -20,18 +20,40 @@
 //! O((N q)³) to O(N q³ + (N q_N)³): most of a patch sticks at moderate amplitude, and only the
 //! nodes that slip or lift off enter the dense system.
 //!
+//! **Iterative reduced system.** When every direction of a large patch slips or opens in the
+//! period, `M` is the whole `(2N+1) q` system and its dense LU the whole cost (1.7 s at q = 300,
+//! N = 7). Above [`DIRECT_UP_TO`] unknowns `M` is not formed: `M u = y` is solved by BiCGSTAB
+//! (faer's `matrix_free::bicgstab`), `M` applied as `u + G (B_N u)` (`G = E_Nᵀ C`, block
+//! diagonal over harmonics; `B_N` block diagonal over elements), right-preconditioned by
+//! `P = I + G B̄` with `B̄` the part of `B_N` that does not couple harmonics, in complex form (the
+//! mean stiffness of each element over the period): one complex LU of size q_N per harmonic.
+//! The time-varying part of the stiffness is what the iterations resolve. Converged to 1e-12
+//! relative (an inexact Newton step far below the continuation's tolerance); if it is not,
+//! `M` is formed and factored as below it.
+//!
 //! A block counts as invariant when its entries coupling different harmonics are below
 //! `1e-10` of its largest entry (a stuck element's are round-off of the AFT); neglecting them
 //! changes the Newton step by as much, far below the continuation's tolerance.
 
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::{c64, Mat};
+use faer::matrix_free::bicgstab::{bicgstab, bicgstab_scratch, BicgParams};
+use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
+use faer::{c64, Mat, MatMut, MatRef, Par};
 
 use super::fourier::{cos_index, sin_index};
 use super::receptance::HarmonicReceptance;
 
 /// Relative size of the harmonic couplings below which an element's block is invariant.
 const INVARIANT: f64 = 1e-10;
+
+/// Largest reduced system `M` ((2N+1) q_N unknowns) factored densely; above, it is solved
+/// iteratively (module docs). At 1200 unknowns the dense LU takes ~30 ms.
+const DIRECT_UP_TO: usize = 1200;
+
+/// Relative residual of the iterative solve of `M`, and its iteration limit.
+const ITERATIVE_TOLERANCE: f64 = 1e-12;
+const ITERATIVE_MAX: usize = 300;
 
 /// Harmonic of coefficient `c` in the coefficient-major layout (0: constant, then cos k, sin k).
 fn harmonic_of(c: usize) -> usize {
@@ -62,8 +84,16 @@ pub struct StructuredJacobian {
     n_elements: Vec<(usize, Mat<f64>)>,
     /// `C_k = A_k⁻¹ H_k E_N` per harmonic (complex q × q_N).
     coupling: Vec<Mat<c64>>,
-    /// LU of `M`, or `None` when every element is invariant.
-    reduced: Option<PartialPivLu<f64>>,
+    /// `M`'s solver, or `None` when every element is invariant.
+    reduced: Option<Reduced>,
+}
+
+/// How `M u = y` is solved.
+enum Reduced {
+    /// LU of `M`.
+    Dense(PartialPivLu<f64>),
+    /// BiCGSTAB on `M` with the harmonic-block preconditioner (module docs).
+    Iterative(Box<ReducedOperator>),
 }
 
 impl StructuredJacobian {
@@ -126,7 +156,13 @@ impl StructuredJacobian {
             blocks.push(lu);
             coupling.push(ck);
         }
-        let reduced = (qn > 0).then(|| reduced_matrix(nc, &n_dirs, &n_elements, &coupling).partial_piv_lu());
+        let reduced = (qn > 0).then(|| {
+            if nc * qn <= DIRECT_UP_TO {
+                Reduced::Dense(reduced_matrix(nc, &n_dirs, &n_elements, &coupling).partial_piv_lu())
+            } else {
+                Reduced::Iterative(Box::new(ReducedOperator::new(nc, &n_dirs, &n_elements, &coupling)))
+            }
+        });
         Some(StructuredJacobian { q, n_coeffs: nc, blocks, n_dirs, n_elements, coupling, reduced })
     }
 
@@ -148,7 +184,15 @@ impl StructuredJacobian {
         }
         let Some(reduced) = &self.reduced else { return b.iter().all(|v| v.is_finite()) };
         // u = M⁻¹ E_Nᵀ w (real, coefficient-major on the N directions), v = B_N u.
-        let u = reduced.solve(Mat::from_fn(nc * qn, 1, |row, _| b[(row / qn) * q + self.n_dirs[row % qn]]));
+        let y = Mat::from_fn(nc * qn, 1, |row, _| b[(row / qn) * q + self.n_dirs[row % qn]]);
+        let u = match reduced {
+            Reduced::Dense(lu) => lu.solve(&y),
+            Reduced::Iterative(op) => match op.solve(y.as_ref()) {
+                Some(u) => u,
+                // Not converged: M formed and factored after all.
+                None => reduced_matrix(nc, &self.n_dirs, &self.n_elements, &self.coupling).partial_piv_lu().solve(&y),
+            },
+        };
         let mut v = vec![0.0; nc * qn];
         for (first, je) in &self.n_elements {
             let d = je.nrows() / nc;
@@ -175,6 +219,195 @@ impl StructuredJacobian {
         b.iter().all(|v| v.is_finite())
     }
 }
+
+/// `M = I + G B_N` applied without forming it, and its preconditioner `P = I + G B̄` factored
+/// per harmonic (module docs).
+struct ReducedOperator {
+    nc: usize,
+    qn: usize,
+    /// `G_k = E_Nᵀ C_k` per harmonic (complex q_N square).
+    g: Vec<Mat<c64>>,
+    /// The elements that couple harmonics: first position among the N directions, block of B.
+    elements: Vec<(usize, Mat<f64>)>,
+    /// LU of `P_k` per harmonic.
+    precond: Vec<PartialPivLu<c64>>,
+}
+
+impl std::fmt::Debug for ReducedOperator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ReducedOperator").field("nc", &self.nc).field("qn", &self.qn).finish()
+    }
+}
+
+impl ReducedOperator {
+    fn new(nc: usize, n_dirs: &[usize], n_elements: &[(usize, Mat<f64>)], coupling: &[Mat<c64>]) -> Self {
+        let qn = n_dirs.len();
+        let g: Vec<Mat<c64>> = coupling.iter().map(|ck| Mat::from_fn(qn, qn, |i, j| ck[(n_dirs[i], j)])).collect();
+        let precond = g
+            .iter()
+            .enumerate()
+            .map(|(k, gk)| {
+                // P_k = I + G_k B̄_k: each element's mean complex block on its columns.
+                let mut p = Mat::<c64>::identity(qn, qn);
+                for (first, je) in n_elements {
+                    let d = je.nrows() / nc;
+                    for col in 0..d {
+                        for row in 0..d {
+                            let b = mean_complex(je, d, k, row, col);
+                            if b == c64::new(0.0, 0.0) {
+                                continue;
+                            }
+                            for i in 0..qn {
+                                p[(i, first + col)] += gk[(i, first + row)] * b;
+                            }
+                        }
+                    }
+                }
+                p.partial_piv_lu()
+            })
+            .collect();
+        ReducedOperator { nc, qn, g, elements: n_elements.to_vec(), precond }
+    }
+
+    /// `M⁻¹ y` by BiCGSTAB, `None` if it does not converge.
+    fn solve(&self, y: MatRef<'_, f64>) -> Option<Mat<f64>> {
+        let n = self.nc * self.qn;
+        let mut u = Mat::<f64>::zeros(n, 1);
+        let identity = faer::matrix_free::IdentityPrecond { dim: n };
+        let params = BicgParams {
+            // From u = 0, passed as a guess: faer 0.24's `Zero` leaves the first residual unset.
+            initial_guess: InitialGuessStatus::MaybeNonZero,
+            rel_tolerance: ITERATIVE_TOLERANCE,
+            max_iters: ITERATIVE_MAX,
+            ..Default::default()
+        };
+        let (matrix, preconditioner) = (ReducedMatrix(self), ReducedPreconditioner(self));
+        let scratch = bicgstab_scratch(identity, &preconditioner, &matrix, 1, Par::Seq);
+        let mut buffer = MemBuffer::new(scratch);
+        let result = bicgstab(
+            u.as_mut(),
+            identity,
+            &preconditioner,
+            &matrix,
+            y,
+            params,
+            |_| {},
+            Par::Seq,
+            MemStack::new(&mut buffer),
+        );
+        (result.is_ok() && u.col(0).iter().all(|v| v.is_finite())).then_some(u)
+    }
+
+    /// `B_N u` (real, coefficient-major on the N directions).
+    fn apply_elements(&self, u: &[f64], v: &mut [f64]) {
+        let (nc, qn) = (self.nc, self.qn);
+        for (first, je) in &self.elements {
+            let d = je.nrows() / nc;
+            for c1 in 0..nc {
+                for a in 0..d {
+                    let mut sum = 0.0;
+                    for c2 in 0..nc {
+                        for bb in 0..d {
+                            sum += je[(c1 * d + a, c2 * d + bb)] * u[c2 * qn + first + bb];
+                        }
+                    }
+                    v[c1 * qn + first + a] = sum;
+                }
+            }
+        }
+    }
+}
+
+/// The complex form (`x_k = c − i s`) of the part of an element's block that does not couple
+/// harmonics, at harmonic k, entry (row, col): `(K_cc + K_ss)/2 + i (K_cs − K_sc)/2`, exact for
+/// an invariant block.
+fn mean_complex(je: &Mat<f64>, d: usize, k: usize, row: usize, col: usize) -> c64 {
+    if k == 0 {
+        return c64::new(je[(row, col)], 0.0);
+    }
+    let (c, s) = (cos_index(k) * d, sin_index(k) * d);
+    c64::new(
+        0.5 * (je[(c + row, c + col)] + je[(s + row, s + col)]),
+        0.5 * (je[(c + row, s + col)] - je[(s + row, c + col)]),
+    )
+}
+
+/// `M` as an operator for the iterative solver.
+#[derive(Debug)]
+struct ReducedMatrix<'a>(&'a ReducedOperator);
+
+/// `P⁻¹` as an operator for the iterative solver.
+#[derive(Debug)]
+struct ReducedPreconditioner<'a>(&'a ReducedOperator);
+
+impl LinOp<f64> for ReducedMatrix<'_> {
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+    fn nrows(&self) -> usize {
+        self.0.nc * self.0.qn
+    }
+    fn ncols(&self) -> usize {
+        self.0.nc * self.0.qn
+    }
+    /// `M u = u + G (B_N u)`.
+    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        let op = self.0;
+        let (n, qn) = (op.nc * op.qn, op.qn);
+        for col in 0..rhs.ncols() {
+            let u: Vec<f64> = (0..n).map(|i| rhs[(i, col)]).collect();
+            let mut v = vec![0.0; n];
+            op.apply_elements(&u, &mut v);
+            let mut w = vec![0.0; n];
+            for (k, gk) in op.g.iter().enumerate() {
+                let gv = gk * Mat::from_fn(qn, 1, |j, _| complex_at(&v, qn, k, j));
+                for i in 0..qn {
+                    set_complex(&mut w, qn, k, i, gv[(i, 0)]);
+                }
+            }
+            for i in 0..n {
+                out[(i, col)] = u[i] + w[i];
+            }
+        }
+    }
+    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
+        self.apply(out, rhs, par, stack)
+    }
+}
+
+impl LinOp<f64> for ReducedPreconditioner<'_> {
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+    fn nrows(&self) -> usize {
+        self.0.nc * self.0.qn
+    }
+    fn ncols(&self) -> usize {
+        self.0.nc * self.0.qn
+    }
+    /// `P⁻¹ y`, harmonic by harmonic.
+    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        let op = self.0;
+        let (n, qn) = (op.nc * op.qn, op.qn);
+        for col in 0..rhs.ncols() {
+            let mut x: Vec<f64> = (0..n).map(|i| rhs[(i, col)]).collect();
+            for (k, lu) in op.precond.iter().enumerate() {
+                let z = lu.solve(Mat::from_fn(qn, 1, |j, _| complex_at(&x, qn, k, j)));
+                for i in 0..qn {
+                    set_complex(&mut x, qn, k, i, z[(i, 0)]);
+                }
+            }
+            for (i, v) in x.into_iter().enumerate() {
+                out[(i, col)] = v;
+            }
+        }
+    }
+    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
+        self.apply(out, rhs, par, stack)
+    }
+}
+
+impl Precond<f64> for ReducedPreconditioner<'_> {}
 
 /// `c − i s` of harmonic k, direction i, in a coefficient-major vector of width `width`.
 fn complex_at(x: &[f64], width: usize, k: usize, i: usize) -> c64 {
