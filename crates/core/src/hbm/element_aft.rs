@@ -603,7 +603,7 @@ fn accumulate_basis(target: &mut [f64], d: usize, b: usize, alpha: f64, beta: f6
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elements::{CubicSpring, Iwan, Jenkins, RegularizedCoulomb};
+    use crate::elements::{Contact, CubicSpring, Iwan, Jenkins, RegularizedCoulomb};
     use crate::hbm::fourier::{cos_index, sin_index};
 
     /// Closed forms of /work/shared/reference/jenkins-closed-form.md for u = a cos θ.
@@ -762,6 +762,67 @@ mod tests {
                 }
             }
             assert_eq!(a1.slipping, a2.slipping);
+        }
+    }
+
+    #[test]
+    fn a_slowly_forgotten_transverse_position_is_extrapolated_to_the_long_march() {
+        // A 3-D contact (constant normal load, μN = 50 N, μN/k_t = 5e-5 m) slides along t1 a
+        // little beyond its elastic range (a = 5.2e-5 m) on a thin ellipse, with a transverse
+        // offset (k_t · 2e-5 m < μN). Each slipping sample multiplies the error of the slider's
+        // transverse position by μN/|T_trial|, close to 1: a plain march forgets it
+        // geometrically, slowly (196 periods to repeat to 1e-15 of the motion, beyond the
+        // AFT's limit of 50). Aitken's jump (the march's extrapolation) reaches the periodic
+        // state within the limit, and the force is the long march's, to the periodicity
+        // tolerance (1e-12 of the state): 1e-9 of μN asserted on harmonic 1.
+        let (kt, kn, mu, n0, eps, a, offset) = (1e6, 1e6, 0.5, 100.0, 0.02, 5.2e-5, 2e-5);
+        let law = Contact::new_3d(kt, kn, mu, n0).unwrap();
+        let plan = AftPlan::new(3, 256).unwrap();
+        let (nc, nt) = (plan.n_coeffs(), 256);
+        let mut u = vec![0.0; 3 * nc];
+        u[1] = offset;
+        u[cos_index(1) * 3] = a;
+        u[sin_index(1) * 3 + 1] = eps * a;
+        let mut g = vec![0.0; 3 * nc];
+        let mut aft = ElementAft::new(&law, &plan);
+        aft.evaluate(&law, &plan, 1000.0, &u, &mut g, None).unwrap();
+
+        // The long march, sample by sample from the law's initial state at θ = 0.
+        let samples = |j: usize| {
+            let th = 2.0 * std::f64::consts::PI * j as f64 / nt as f64;
+            [a * th.cos(), offset + eps * a * th.sin(), 0.0]
+        };
+        let mut state = vec![0.0; 2];
+        law.initial_state(&samples(0), &mut state, None);
+        let (mut force, mut periods) = (vec![[0.0; 3]; nt], 0);
+        loop {
+            periods += 1;
+            let start = state.clone();
+            for (j, f) in force.iter_mut().enumerate() {
+                law.update(&samples((j + 1) % nt), &[0.0; 3], &mut state, f, None);
+            }
+            let change = start.iter().zip(&state).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            if change <= 1e-15 * a || periods == 100_000 {
+                break;
+            }
+        }
+        assert!(periods > MAX_PERIODS, "the plain march repeats after {periods} periods: no jump needed");
+        assert!(aft.periods < MAX_PERIODS, "{} periods with the jump", aft.periods);
+        // Harmonic 1 of both tangential forces (force[j] is at sample j + 1).
+        for dir in 0..2 {
+            let (mut c1, mut s1) = (0.0, 0.0);
+            for (j, f) in force.iter().enumerate() {
+                let th = 2.0 * std::f64::consts::PI * ((j + 1) % nt) as f64 / nt as f64;
+                c1 += 2.0 / nt as f64 * f[dir] * th.cos();
+                s1 += 2.0 / nt as f64 * f[dir] * th.sin();
+            }
+            let (gc, gs) = (g[cos_index(1) * 3 + dir], g[sin_index(1) * 3 + dir]);
+            let err = (gc - c1).hypot(gs - s1);
+            assert!(err < 1e-9 * mu * n0, "direction {dir}: ({gc}, {gs}) against ({c1}, {s1})");
+            println!(
+                "direction {dir}: harmonic 1 differs by {err:.1e} N; plain march {periods} periods, AFT {}",
+                aft.periods
+            );
         }
     }
 
