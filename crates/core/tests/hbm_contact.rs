@@ -498,6 +498,19 @@ impl EventReference {
     }
 }
 
+/// The 2-D contact's AFT at `n_t` samples for `u_t = a cos θ`, `u_n = b cos(θ − φ)`: the energy
+/// per cycle `∮ T du_t = −π a s₁` (harmonic 1 alone moves) and harmonic 1 of T, `(W, c₁, s₁)`.
+fn aft_harmonic_1(law: &Contact, nt: usize, a: f64, b: f64, phi: f64) -> (f64, f64, f64) {
+    let plan = AftPlan::new(3, nt).unwrap();
+    let mut u = vec![0.0; 2 * plan.n_coeffs()];
+    u[cos_index(1) * 2] = a;
+    u[cos_index(1) * 2 + 1] = b * phi.cos();
+    u[sin_index(1) * 2 + 1] = b * phi.sin();
+    let (g, _, _) = aft(law, &plan, &u);
+    let (c1, s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
+    (PI * a * (-s1), c1, s1)
+}
+
 #[test]
 fn variable_normal_load_matches_the_event_resolved_solution() {
     // k_t = 1e6 N/m, k_n = 2e6 N/m, μ = 0.4, N0 = 400 N: μN0/k_t = 1.6e-4 m, the contact opens
@@ -515,15 +528,7 @@ fn variable_normal_load_matches_the_event_resolved_solution() {
         let (w_ref, c_ref, s_ref) = reference.solve();
         let mut errors = Vec::new();
         for nt in [256, 1024, 4096] {
-            let plan = AftPlan::new(3, nt).unwrap();
-            let mut u = vec![0.0; 2 * plan.n_coeffs()];
-            u[cos_index(1) * 2] = a;
-            u[cos_index(1) * 2 + 1] = b * phi.cos();
-            u[sin_index(1) * 2 + 1] = b * phi.sin();
-            let (g, _, _) = aft(&law, &plan, &u);
-            let (c1, s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
-            // ∮ T du_t = π a s1 for u_t = a cos θ (harmonic 1 only moves).
-            let w = PI * a * (-s1);
+            let (w, c1, s1) = aft_harmonic_1(&law, nt, a, b, phi);
             let e_w = (w - w_ref).abs() / w_ref;
             // Equivalent stiffness c1/a and the dissipative part s1, relative to |T_1|.
             let e_1 = (c1 - c_ref).hypot(s1 - s_ref) / c_ref.hypot(s_ref);
@@ -633,14 +638,7 @@ fn variable_normal_load_matches_the_closed_forms() {
         // The AFT at 300 samples: each switch placed to within a sample, second-order errors
         // (8e-5 measured at 256 samples in the event-resolved test): asserted 1e-3, a tenth of
         // the 1 % asked.
-        let plan = AftPlan::new(3, 300).unwrap();
-        let mut u = vec![0.0; 2 * plan.n_coeffs()];
-        u[cos_index(1) * 2] = a;
-        u[cos_index(1) * 2 + 1] = b * phi.cos();
-        u[sin_index(1) * 2 + 1] = b * phi.sin();
-        let (g, _, _) = aft(&law, &plan, &u);
-        let (g_c1, g_s1) = (g[cos_index(1) * 2], g[sin_index(1) * 2]);
-        let w_aft = PI * a * (-g_s1);
+        let (w_aft, g_c1, g_s1) = aft_harmonic_1(&law, 300, a, b, phi);
         assert!((w_aft - w).abs() < 1e-3 * w, "{what}: W {w_aft} AFT, {w} closed form");
         assert!((g_c1 - c1).hypot(g_s1 - s1) < 1e-3 * c1.hypot(s1), "{what}: T₁ ({g_c1}, {g_s1}) AFT");
         println!(

@@ -187,27 +187,14 @@ impl StructuredJacobian {
         let y = Mat::from_fn(nc * qn, 1, |row, _| b[(row / qn) * q + self.n_dirs[row % qn]]);
         let u = match reduced {
             Reduced::Dense(lu) => lu.solve(&y),
-            Reduced::Iterative(op) => match op.solve(y.as_ref()) {
+            Reduced::Iterative(op) => match op.solve(&self.n_elements, y.as_ref()) {
                 Some(u) => u,
                 // Not converged: M formed and factored after all.
                 None => reduced_matrix(nc, &self.n_dirs, &self.n_elements, &self.coupling).partial_piv_lu().solve(&y),
             },
         };
         let mut v = vec![0.0; nc * qn];
-        for (first, je) in &self.n_elements {
-            let d = je.nrows() / nc;
-            for c1 in 0..nc {
-                for a in 0..d {
-                    let mut sum = 0.0;
-                    for c2 in 0..nc {
-                        for bb in 0..d {
-                            sum += je[(c1 * d + a, c2 * d + bb)] * u[(c2 * qn + first + bb, 0)];
-                        }
-                    }
-                    v[c1 * qn + first + a] = sum;
-                }
-            }
-        }
+        apply_elements(nc, qn, &self.n_elements, u.col(0).try_as_col_major().expect("one column").as_slice(), &mut v);
         // b = w − C v.
         for (k, ck) in self.coupling.iter().enumerate() {
             let cv = ck * Mat::from_fn(qn, 1, |j, _| complex_at(&v, qn, k, j));
@@ -227,8 +214,6 @@ struct ReducedOperator {
     qn: usize,
     /// `G_k = E_Nᵀ C_k` per harmonic (complex q_N square).
     g: Vec<Mat<c64>>,
-    /// The elements that couple harmonics: first position among the N directions, block of B.
-    elements: Vec<(usize, Mat<f64>)>,
     /// LU of `P_k` per harmonic.
     precond: Vec<PartialPivLu<c64>>,
 }
@@ -266,11 +251,11 @@ impl ReducedOperator {
                 p.partial_piv_lu()
             })
             .collect();
-        ReducedOperator { nc, qn, g, elements: n_elements.to_vec(), precond }
+        ReducedOperator { nc, qn, g, precond }
     }
 
-    /// `M⁻¹ y` by BiCGSTAB, `None` if it does not converge.
-    fn solve(&self, y: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    /// `M⁻¹ y` by BiCGSTAB, `None` if it does not converge; `elements` as the Jacobian's.
+    fn solve(&self, elements: &[(usize, Mat<f64>)], y: MatRef<'_, f64>) -> Option<Mat<f64>> {
         let n = self.nc * self.qn;
         let mut u = Mat::<f64>::zeros(n, 1);
         let identity = faer::matrix_free::IdentityPrecond { dim: n };
@@ -281,7 +266,7 @@ impl ReducedOperator {
             max_iters: ITERATIVE_MAX,
             ..Default::default()
         };
-        let (matrix, preconditioner) = (ReducedMatrix(self), ReducedPreconditioner(self));
+        let (matrix, preconditioner) = (ReducedMatrix(self, elements), ReducedPreconditioner(self));
         let scratch = bicgstab_scratch(identity, &preconditioner, &matrix, 1, Par::Seq);
         let mut buffer = MemBuffer::new(scratch);
         let result = bicgstab(
@@ -297,22 +282,22 @@ impl ReducedOperator {
         );
         (result.is_ok() && u.col(0).iter().all(|v| v.is_finite())).then_some(u)
     }
+}
 
-    /// `B_N u` (real, coefficient-major on the N directions).
-    fn apply_elements(&self, u: &[f64], v: &mut [f64]) {
-        let (nc, qn) = (self.nc, self.qn);
-        for (first, je) in &self.elements {
-            let d = je.nrows() / nc;
-            for c1 in 0..nc {
-                for a in 0..d {
-                    let mut sum = 0.0;
-                    for c2 in 0..nc {
-                        for bb in 0..d {
-                            sum += je[(c1 * d + a, c2 * d + bb)] * u[c2 * qn + first + bb];
-                        }
+/// `v = B_N u` (real, coefficient-major on the `q_N` directions of the elements that couple
+/// harmonics, each at its first position).
+fn apply_elements(nc: usize, qn: usize, elements: &[(usize, Mat<f64>)], u: &[f64], v: &mut [f64]) {
+    for (first, je) in elements {
+        let d = je.nrows() / nc;
+        for c1 in 0..nc {
+            for a in 0..d {
+                let mut sum = 0.0;
+                for c2 in 0..nc {
+                    for bb in 0..d {
+                        sum += je[(c1 * d + a, c2 * d + bb)] * u[c2 * qn + first + bb];
                     }
-                    v[c1 * qn + first + a] = sum;
                 }
+                v[c1 * qn + first + a] = sum;
             }
         }
     }
@@ -332,9 +317,9 @@ fn mean_complex(je: &Mat<f64>, d: usize, k: usize, row: usize, col: usize) -> c6
     )
 }
 
-/// `M` as an operator for the iterative solver.
+/// `M` as an operator for the iterative solver, with the elements that couple harmonics.
 #[derive(Debug)]
-struct ReducedMatrix<'a>(&'a ReducedOperator);
+struct ReducedMatrix<'a>(&'a ReducedOperator, &'a [(usize, Mat<f64>)]);
 
 /// `P⁻¹` as an operator for the iterative solver.
 #[derive(Debug)]
@@ -357,7 +342,7 @@ impl LinOp<f64> for ReducedMatrix<'_> {
         for col in 0..rhs.ncols() {
             let u: Vec<f64> = (0..n).map(|i| rhs[(i, col)]).collect();
             let mut v = vec![0.0; n];
-            op.apply_elements(&u, &mut v);
+            apply_elements(op.nc, qn, self.1, &u, &mut v);
             let mut w = vec![0.0; n];
             for (k, gk) in op.g.iter().enumerate() {
                 let gv = gk * Mat::from_fn(qn, 1, |j, _| complex_at(&v, qn, k, j));
