@@ -8,16 +8,17 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use stickslip_core::continuation::{
-    Bracket, Branch, Observer, Options, Predictor, ProblemError, Rejection, Silent, TerminationReason,
+    Accepted, Bracket, Branch, Observer, Options, PointObserver, Predictor, ProblemError, Rejection, Silent,
+    TerminationReason,
 };
 use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::{
-    bifurcations, nonlinear_mode, stability_at, sweep_frequency, sweep_level, Backbone, BranchStabilityError,
-    CondensedHbm, FrequencySweep, HbmSettings as CoreHbmSettings, Hill, HillSettings, NegativeDamping,
-    NonlinearModeError, NonlinearModeSettings, SweepError,
+    bifurcations, nonlinear_mode, stability_at_last_evaluation, sweep_frequency, sweep_level, Backbone,
+    BranchStabilityError, CondensedHbm, FrequencySweep, HbmSettings as CoreHbmSettings, Hill, HillSettings,
+    NegativeDamping, NonlinearModeError, NonlinearModeSettings, Stability, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
-use stickslip_core::post::{evaluate_point, OutputSelector, PointResult};
+use stickslip_core::post::{evaluate_point, point_result, OutputSelector, PointResult};
 
 use crate::output::{
     harmonics_from_coefficients, BifurcationRecord, ElementRecord, JointSides, LevelResult, OutputRecord, Peak,
@@ -168,33 +169,27 @@ impl<'a> LevelSweeper<'a> {
         let (study, hill, selectors) = (self.study, self.hill.as_ref(), self.selectors.as_slice());
         let mut hbm = self.hbm.share_linear_part();
         let options = continuation_options(study);
+        let mut recorder = PointRecorder {
+            study,
+            hill,
+            selectors,
+            progress: observer,
+            points: Vec::new(),
+            stabilities: Vec::new(),
+            error: None,
+        };
         let branch: Branch = sweep_frequency(
             &mut hbm,
             level,
             TWO_PI * study.sweep.start_hz,
             TWO_PI * study.sweep.end_hz,
             &options,
-            observer,
+            &mut recorder,
         )?;
-        let mut points = Vec::with_capacity(branch.points.len());
-        let mut stabilities = Vec::new();
-        for (index, p) in branch.points.iter().enumerate() {
-            let result = evaluate_point(&mut hbm, &p.x, p.lambda, level, selectors)?;
-            // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
-            let residual = p.residual_norm / branch.residual_scale;
-            let mut point = record(&result, p.iterations, residual, study.output_options.time_data.keeps(index));
-            if let Some(hill) = hill {
-                let stability = stability_at(&mut hbm, hill, &p.x, p.lambda)?;
-                let leading = stability.leading();
-                point.stability = Some(PointStability {
-                    stable: is_stable(&stability, p.lambda),
-                    exponent_re: leading.re,
-                    exponent_im: leading.im,
-                });
-                stabilities.push(stability);
-            }
-            points.push(point);
+        if let Some(error) = recorder.error {
+            return Err(error);
         }
+        let PointRecorder { points, stabilities, .. } = recorder;
         let peaks = locate_peaks(&mut hbm, &branch, level, selectors, &points);
         let bifurcations = match hill {
             Some(hill) => bifurcations(&mut hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
@@ -227,6 +222,56 @@ impl<'a> LevelSweeper<'a> {
             result: LevelResult { level_n: level, points, peaks, bifurcations },
             termination: branch.termination,
         })
+    }
+}
+
+/// The record of each point of a level (and its stability, when asked) made as the
+/// continuation accepts it, from the evaluation that converged there (core
+/// [`point_result`], [`stability_at_last_evaluation`]): nothing is evaluated again after the
+/// branch. Progress goes on to the caller's observer.
+struct PointRecorder<'s, O: ?Sized> {
+    study: &'s Study,
+    hill: Option<&'s Hill>,
+    selectors: &'s [OutputSelector],
+    progress: &'s mut O,
+    points: Vec<PointRecord>,
+    stabilities: Vec<Stability>,
+    /// The first failure to post-process a point (the branch runs on; the level reports it).
+    error: Option<SweepError>,
+}
+
+impl<'a, 'm, O: Observer + ?Sized> PointObserver<FrequencySweep<'a, 'm>> for PointRecorder<'_, O> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, FrequencySweep<'a, 'm>>) {
+        let (x, omega) = (&accepted.point().x, accepted.point().lambda);
+        self.progress.on_point(accepted.point(), accepted.fraction_done());
+        if self.error.is_some() {
+            return;
+        }
+        // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
+        let residual = accepted.point().residual_norm / accepted.residual_scale();
+        let (iterations, index) = (accepted.point().iterations, self.points.len());
+        let x = x.clone();
+        let hbm = &mut *accepted.problem().hbm;
+        let outcome = (|| -> Result<(), SweepError> {
+            let result = point_result(hbm, &x, self.selectors)?;
+            let time_data = self.study.output_options.time_data.keeps(index);
+            let mut point = record(&result, iterations, residual, time_data);
+            if let Some(hill) = self.hill {
+                let stability = stability_at_last_evaluation(hbm, hill, &x, omega)?;
+                let leading = stability.leading();
+                point.stability = Some(PointStability {
+                    stable: is_stable(&stability, omega),
+                    exponent_re: leading.re,
+                    exponent_im: leading.im,
+                });
+                self.stabilities.push(stability);
+            }
+            self.points.push(point);
+            Ok(())
+        })();
+        if let Err(error) = outcome {
+            self.error = Some(error);
+        }
     }
 }
 

@@ -6,7 +6,7 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{Mat, MatMut, Par};
+use faer::{Mat, MatMut, MatRef, Par};
 
 use super::{Problem, ProblemError};
 
@@ -83,6 +83,17 @@ impl Workspace {
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
         problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))
+    }
+
+    /// Does the problem factor `∂R/∂x` itself (no dense matrix here)?
+    pub fn factors(&self) -> bool {
+        self.factored
+    }
+
+    /// `∂R/∂x` and `∂R/∂λ` of the last evaluation with the Jacobian (dense; before any solve,
+    /// which factors the matrix in place).
+    pub fn jacobian(&self) -> (MatRef<'_, f64>, &[f64]) {
+        (self.matrix.as_ref().submatrix(0, 0, self.n, self.n), &self.dr_dlambda)
     }
 
     /// `∂R/∂x` (dense, into the matrix) and `∂R/∂λ` at the point of the last evaluation, which

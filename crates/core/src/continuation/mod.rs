@@ -122,7 +122,8 @@ mod run;
 pub use extremum::{maximise_along, zero_along, Bracket, Extremum};
 pub use run::continue_branch;
 
-use faer::MatMut;
+use faer::{MatMut, MatRef};
+use linear::Workspace;
 
 /// `R(x, λ) = 0`, `x ∈ Rⁿ`, `λ` the continuation parameter (Ω, a force level, ...).
 pub trait Problem {
@@ -445,10 +446,90 @@ pub struct Branch {
     pub residual_scale: f64,
 }
 
-/// Receives every converged point as it is accepted.
+/// Receives every converged point as it is accepted (progress, the points alone). An observer
+/// that needs more of each point implements [`PointObserver`] instead.
 pub trait Observer {
     /// `fraction_done` in [0, 1]: the furthest λ reached, as a fraction of the interval.
     fn on_point(&mut self, point: &Point, fraction_done: f64);
+}
+
+/// Receives every converged point as it is accepted, with the problem as it stands there
+/// ([`Accepted`]): what a point's results need (the forces of its elements, the Jacobian that
+/// its stability needs) is read from the evaluation that converged, not computed again after
+/// the branch. Every [`Observer`] is one.
+pub trait PointObserver<P: ?Sized> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, P>);
+}
+
+impl<P: ?Sized, O: Observer + ?Sized> PointObserver<P> for O {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, P>) {
+        self.on_point(accepted.point, accepted.fraction_done)
+    }
+}
+
+/// `∂R/∂x` (n × n) and `∂R/∂λ` at an accepted point ([`Accepted::jacobian`]).
+pub type JacobianAt<'a> = (MatRef<'a, f64>, &'a [f64]);
+
+/// An accepted point as the continuation hands it to a [`PointObserver`]: the point, and the
+/// problem whose last evaluation was the residual at this very point (so per-point data, e.g.
+/// the element forces of a harmonic balance, can be read from it as they stand), with the
+/// Jacobian there on demand ([`Self::jacobian`]).
+pub struct Accepted<'a, P: ?Sized> {
+    point: &'a Point,
+    fraction_done: f64,
+    residual_scale: f64,
+    problem: &'a mut P,
+    workspace: &'a mut Workspace,
+    /// The problem's last evaluation is still the residual alone at the point, which it can
+    /// complete to a Jacobian ([`Problem::complete_jacobian`]).
+    completable: bool,
+    /// Calls made here (the Jacobian), added to the branch's.
+    calls: Calls,
+}
+
+impl<'a, P: Problem + ?Sized> Accepted<'a, P> {
+    pub fn point(&self) -> &Point {
+        self.point
+    }
+
+    /// The furthest λ reached, as a fraction of the interval (in [0, 1]).
+    pub fn fraction_done(&self) -> f64 {
+        self.fraction_done
+    }
+
+    /// The branch's residual scale ([`Branch::residual_scale`]): `point().residual_norm`
+    /// divided by it is the measure Newton's tolerance applies to.
+    pub fn residual_scale(&self) -> f64 {
+        self.residual_scale
+    }
+
+    /// The problem, its last evaluation the residual at the point. An observer that evaluates
+    /// it elsewhere changes that: [`Self::jacobian`] then evaluates the problem at the point
+    /// again (ask for the Jacobian first to avoid it).
+    pub fn problem(&mut self) -> &mut P {
+        self.completable = false;
+        self.problem
+    }
+
+    /// `∂R/∂x` (n × n) and `∂R/∂λ` at the point: completed from the converged residual
+    /// evaluation where the problem can ([`Problem::completes_jacobian`]), else evaluated
+    /// there. `None` for a problem that factors its own Jacobian ([`Problem::factored`]): the
+    /// continuation never has it dense.
+    pub fn jacobian(&mut self) -> Result<Option<JacobianAt<'_>>, ProblemError> {
+        if self.workspace.factors() {
+            return Ok(None);
+        }
+        if self.completable {
+            self.calls += Calls { residuals: 0, jacobians: 1, factorizations: 0 };
+            self.workspace.complete(self.problem)?;
+        } else {
+            self.calls += Calls { residuals: 1, jacobians: 1, factorizations: 0 };
+            self.workspace.evaluate(self.problem, &self.point.x, self.point.lambda, true)?;
+        }
+        // The problem's last evaluation is now the point's, with its Jacobian.
+        self.completable = false;
+        Ok(Some(self.workspace.jacobian()))
+    }
 }
 
 impl<F: FnMut(&Point, f64)> Observer for F {

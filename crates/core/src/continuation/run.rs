@@ -3,8 +3,8 @@
 
 use super::linear::Workspace;
 use super::{
-    Branch, Calls, ContinuationError, Observer, Options, Point, Predictor, Problem, ProblemError, Rejection,
-    TerminationReason,
+    Accepted, Branch, Calls, ContinuationError, Options, Point, PointObserver, Predictor, Problem, ProblemError,
+    Rejection, TerminationReason,
 };
 
 /// Follow the solution curve of `problem` from `λ_start` (solved from `x_guess`) to `λ_end`.
@@ -12,7 +12,7 @@ use super::{
 /// Invalid input (options, guess, interval, scales) is an `Err`; everything that happens during
 /// the continuation, failures included, is a [`TerminationReason`] in the returned [`Branch`],
 /// which keeps every converged point.
-pub fn continue_branch<P: Problem + ?Sized, O: Observer + ?Sized>(
+pub fn continue_branch<P: Problem + ?Sized, O: PointObserver<P> + ?Sized>(
     problem: &mut P,
     x_guess: &[f64],
     lambda_start: f64,
@@ -200,6 +200,8 @@ struct Runner<'a, P: ?Sized> {
     tangent: Vec<f64>,
     /// The last error at a trial iterate, and where.
     trial_error: Option<(f64, ProblemError)>,
+    /// The last evaluation was of the residual alone.
+    last_residual_only: bool,
 }
 
 impl<'a, P: Problem + ?Sized> Runner<'a, P> {
@@ -230,10 +232,11 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             previous_direction: zeros.clone(),
             tangent: zeros,
             trial_error: None,
+            last_residual_only: false,
         }
     }
 
-    fn run<O: Observer + ?Sized>(
+    fn run<O: PointObserver<P> + ?Sized>(
         &mut self,
         x_guess: &[f64],
         residual_scale: Option<f64>,
@@ -278,7 +281,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             let across_band = if dx_dlambda.is_finite() { dx_dlambda * self.scale.lambda } else { 0.0 };
             self.scale.x = positive_or_one(norm(&first.x).max(across_band));
         }
-        observer.on_point(&first, 0.0);
+        self.hand_over(observer, &first, 0.0);
         points.push(first);
 
         let mut control = StepControl {
@@ -364,7 +367,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                     Outcome::Converged { iterations, residual_norm } => {
                         let step = distance(&self.z, &self.z_last);
                         let point = self.make_point(boundary, iterations, residual_norm, step, control.attempts);
-                        observer.on_point(&point, if beyond_end { 1.0 } else { furthest });
+                        self.hand_over(observer, &point, if beyond_end { 1.0 } else { furthest });
                         points.push(point);
                         return if beyond_end {
                             TerminationReason::ReachedEnd
@@ -408,13 +411,30 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             }
             let fraction = ((lambda_new - self.lambda_start) / (self.lambda_end - self.lambda_start)).clamp(0.0, 1.0);
             furthest = f64::max(furthest, fraction);
-            observer.on_point(&point, furthest);
+            self.hand_over(observer, &point, furthest);
             points.push(point);
             fallback_tangent = None;
 
             // ADAPT STEP
             control.accept(iterations, options);
         }
+    }
+
+    /// Hand an accepted point to the observer, the problem as the converged evaluation left it.
+    fn hand_over<O: PointObserver<P> + ?Sized>(&mut self, observer: &mut O, point: &Point, fraction_done: f64) {
+        let mut accepted = Accepted {
+            point,
+            fraction_done,
+            residual_scale: self.scale.residual,
+            completable: self.ws.lazy && self.last_residual_only,
+            problem: &mut *self.problem,
+            workspace: &mut self.ws,
+            calls: Calls::default(),
+        };
+        observer.on_accepted(&mut accepted);
+        self.total += accepted.calls;
+        // Whatever the observer evaluated, the next step starts from a fresh evaluation.
+        self.last_residual_only = false;
     }
 
     /// `‖R(0, λ)‖` (the forcing of a forced problem) at λ_start, or at λ_end when it vanishes
@@ -548,6 +568,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         let calls = Calls { residuals: 1, jacobians: usize::from(with_jacobian), factorizations: 0 };
         self.calls += calls;
         self.total += calls;
+        self.last_residual_only = !with_jacobian;
         self.ws.evaluate(self.problem, &self.x_phys, lambda, with_jacobian)?;
         Ok(norm(&self.ws.residual))
     }
@@ -608,6 +629,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 let calls = Calls { residuals: 0, jacobians: 1, factorizations: 0 };
                 self.calls += calls;
                 self.total += calls;
+                self.last_residual_only = false;
                 if let Err(error) = self.ws.complete(self.problem) {
                     return self.problem_outcome(iterations, lambda, error);
                 }

@@ -13,7 +13,7 @@
 //! Each is located between its two points by [`zero_along`] on the leading exponent's real
 //! part, along the branch (through a fold as well as along an arc).
 
-use faer::c64;
+use faer::{c64, Mat};
 
 use super::condensed::{CondensedHbm, HbmError};
 use super::stability::{Hill, Stability, StabilityError};
@@ -88,7 +88,22 @@ pub fn stability_at(
     x: &[f64],
     omega: f64,
 ) -> Result<Stability, BranchStabilityError> {
-    refined_stability(hbm, hill, x, omega, false)
+    let jacobian = hbm.element_force_jacobian(x, omega)?;
+    refined_stability(hbm, hill, jacobian, omega, false)
+}
+
+/// [`stability_at`] of the solution `x`, Ω at which `hbm` was last evaluated (a continuation's
+/// converged evaluation, handed to its observer): the joints' Jacobian is completed from that
+/// evaluation ([`CondensedHbm::element_force_jacobian_at_last`]) instead of evaluated again.
+/// The same exponents.
+pub fn stability_at_last_evaluation(
+    hbm: &mut CondensedHbm<'_>,
+    hill: &Hill,
+    x: &[f64],
+    omega: f64,
+) -> Result<Stability, BranchStabilityError> {
+    let jacobian = hbm.element_force_jacobian_at_last(x, omega)?;
+    refined_stability(hbm, hill, jacobian, omega, false)
 }
 
 /// [`stability_at`] with the sliders' memory refined by the fixed point of dense eigenproblems
@@ -99,17 +114,18 @@ pub fn stability_by_eigenproblems(
     x: &[f64],
     omega: f64,
 ) -> Result<Stability, BranchStabilityError> {
-    refined_stability(hbm, hill, x, omega, true)
+    let jacobian = hbm.element_force_jacobian(x, omega)?;
+    refined_stability(hbm, hill, jacobian, omega, true)
 }
 
+/// The exponents from the joints' Jacobian `∂G/∂x` of the solution `hbm` was last evaluated at.
 fn refined_stability(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
-    x: &[f64],
+    jacobian: Mat<f64>,
     omega: f64,
     reference: bool,
 ) -> Result<Stability, BranchStabilityError> {
-    let jacobian = hbm.element_force_jacobian(x, omega)?;
     let mut stability = hill.exponents(omega, jacobian.as_ref())?;
     if !hbm.has_memory_delay() {
         return Ok(stability);

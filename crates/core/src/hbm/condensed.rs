@@ -60,6 +60,8 @@ pub enum HbmError {
     NoConvergence { frequency_hz: f64, level: f64, iterations: usize, residual: f64 },
     #[error("the excitation pattern has length {got}, expected {expected}")]
     ForceLength { got: usize, expected: usize },
+    #[error("the balance has not been evaluated: there is no solution to post-process")]
+    NotEvaluated,
 }
 
 /// Size of the condensed problem ((2N+1)q unknowns) from which the Newton systems are solved
@@ -527,6 +529,24 @@ impl<'m> CondensedHbm<'m> {
     /// ([`super::stability`]).
     pub fn element_force_jacobian(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
         self.element_forces(x, omega, true)?;
+        let jac = self.joints.assembled_jacobian(self.model, self.plan.n_coeffs(), |_, _| {});
+        Ok(Mat::from_fn(jac.nrows(), jac.ncols(), |i, j| jac[(i, j)].re))
+    }
+
+    /// Ω and λ_F of the last evaluation, if it succeeded.
+    pub fn last_evaluation(&self) -> Option<(f64, f64)> {
+        self.last
+    }
+
+    /// [`Self::element_force_jacobian`] at the solution `x`, Ω of the last evaluation (a
+    /// continuation's converged one, made for the residual alone): completed from its slip
+    /// flags when every element is a slider ([`JointForces::complete_jacobian`]), else
+    /// evaluated at `x` again.
+    pub fn element_force_jacobian_at_last(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
+        let here = self.last.is_some_and(|(w, _)| w == omega);
+        if !(here && self.sliders_only && self.joints.complete_jacobian(self.model, &self.plan)) {
+            return self.element_force_jacobian(x, omega);
+        }
         let jac = self.joints.assembled_jacobian(self.model, self.plan.n_coeffs(), |_, _| {});
         Ok(Mat::from_fn(jac.nrows(), jac.ncols(), |i, j| jac[(i, j)].re))
     }

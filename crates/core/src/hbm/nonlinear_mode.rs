@@ -57,7 +57,8 @@ use super::element_aft::AftError;
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
 use crate::continuation::{
-    continue_branch, Branch, ContinuationError, Observer, Options, Problem, ProblemError, Scales, TerminationReason,
+    continue_branch, Branch, ContinuationError, Options, PointObserver, Problem, ProblemError, Scales,
+    TerminationReason,
 };
 use crate::model::{ModelError, NonlinearModel};
 
@@ -750,8 +751,8 @@ impl Problem for NonlinearMode<'_> {
 /// The branch starts from the linear mode, which must still hold at `amplitude_start` (else
 /// [`NonlinearModeError::NonlinearStart`]). A model without joints has only its linear mode:
 /// it is returned at the two ends of the range, with a note.
-pub fn nonlinear_mode<O: Observer + ?Sized>(
-    model: &NonlinearModel,
+pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
+    model: &'m NonlinearModel,
     settings: &NonlinearModeSettings,
     amplitude_start: f64,
     amplitude_end: f64,

@@ -6,8 +6,8 @@ use faer::MatMut;
 
 use super::condensed::{CondensedHbm, HbmError, Jacobians};
 use crate::continuation::{
-    continue_branch, Branch, ContinuationError, FactoredJacobian, Observer, Options, Problem, ProblemError, Silent,
-    TerminationReason,
+    continue_branch, Branch, ContinuationError, FactoredJacobian, Options, PointObserver, Problem, ProblemError,
+    Silent, TerminationReason,
 };
 
 /// A sweep that could not start (a failure during the sweep is a termination reason of the
@@ -156,8 +156,8 @@ fn problem_error(e: HbmError) -> ProblemError {
 /// When Newton cannot reach the first point from the stuck solution (a joint already slipping
 /// hard at the start of the band), the start is found by continuation in the force level at
 /// `omega_start`, from a level where the joints stick up to `level`.
-pub fn sweep_frequency<O: Observer + ?Sized>(
-    hbm: &mut CondensedHbm<'_>,
+pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 'm>>>(
+    hbm: &mut CondensedHbm<'m>,
     level: f64,
     omega_start: f64,
     omega_end: f64,
@@ -204,8 +204,8 @@ pub fn off_resonance(hbm: &mut CondensedHbm<'_>, omega: f64, omega_toward: f64, 
 
 /// Continue the periodic response at frequency `omega` (rad/s) in the force level from
 /// `level_start` to `level_end`.
-pub fn sweep_level<O: Observer + ?Sized>(
-    hbm: &mut CondensedHbm<'_>,
+pub fn sweep_level<'m, O: ?Sized + for<'a> PointObserver<LevelSweep<'a, 'm>>>(
+    hbm: &mut CondensedHbm<'m>,
     omega: f64,
     level_start: f64,
     level_end: f64,

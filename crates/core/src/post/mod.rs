@@ -90,7 +90,8 @@ impl PointResult {
     }
 }
 
-/// Post-process a converged solution `x` of `hbm` at (Ω, λ_F).
+/// Post-process a converged solution `x` of `hbm` at (Ω, λ_F): evaluate the balance there,
+/// then [`point_result`].
 pub fn evaluate_point(
     hbm: &mut CondensedHbm<'_>,
     x: &[f64],
@@ -98,10 +99,21 @@ pub fn evaluate_point(
     level: f64,
     outputs: &[OutputSelector],
 ) -> Result<PointResult, HbmError> {
-    let q = hbm.n_directions();
     let mut residual = vec![0.0; hbm.dimension()];
     // Fills the elements' time samples and force harmonics at x.
     hbm.evaluate(x, omega, level, &mut residual, None)?;
+    point_result(hbm, x, outputs)
+}
+
+/// Post-process the solution `x` at which `hbm` was last evaluated (the converged evaluation
+/// of a continuation, handed to its observer): the elements' forces and time samples are
+/// read as that evaluation left them, not computed again. An error if `hbm` was never
+/// evaluated.
+pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector]) -> Result<PointResult, HbmError> {
+    let Some((omega, level)) = hbm.last_evaluation() else {
+        return Err(HbmError::NotEvaluated);
+    };
+    let q = hbm.n_directions();
     let plan = hbm.plan();
     let (nh, nc, nt) = (plan.n_harmonics(), plan.n_coeffs(), plan.n_samples());
     let g = hbm.element_force_harmonics().to_vec();

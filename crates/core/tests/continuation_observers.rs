@@ -1,0 +1,131 @@
+//! What the continuation hands its observers at each accepted point ([`Accepted`]): the
+//! problem as the converged evaluation left it, and the Jacobian there on demand. Checked
+//! against evaluating each point again after the branch, the way results were made before:
+//! the point's results, its stability and its Jacobian must be the same numbers.
+#[path = "../benches/common/mod.rs"]
+mod common;
+
+use faer::Mat;
+use stickslip_core::continuation::{Accepted, Options, PointObserver, Silent, TerminationReason};
+use stickslip_core::hbm::{
+    stability_at, stability_at_last_evaluation, sweep_frequency, CondensedHbm, FrequencySweep, HbmSettings, Hill,
+    HillSettings, Jacobians, Stability,
+};
+use stickslip_core::model::NonlinearModel;
+use stickslip_core::post::{evaluate_point, point_result, OutputSelector, PointResult};
+
+const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+
+/// Everything an observer takes from each accepted point.
+struct Taken<'h> {
+    hill: &'h Hill,
+    outputs: Vec<OutputSelector>,
+    results: Vec<PointResult>,
+    stabilities: Vec<Stability>,
+    jacobians: Vec<(Mat<f64>, Vec<f64>)>,
+    fractions: Vec<f64>,
+}
+
+impl<'a, 'm> PointObserver<FrequencySweep<'a, 'm>> for Taken<'_> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, FrequencySweep<'a, 'm>>) {
+        self.fractions.push(accepted.fraction_done());
+        // The Jacobian first: it is completed from the converged evaluation.
+        let (dx, dl) = accepted.jacobian().unwrap().expect("a dense Jacobian");
+        self.jacobians.push((dx.to_owned(), dl.to_vec()));
+        let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
+        let hbm = &mut *accepted.problem().hbm;
+        self.results.push(point_result(hbm, &x, &self.outputs).unwrap());
+        self.stabilities.push(stability_at_last_evaluation(hbm, self.hill, &x, omega).unwrap());
+    }
+}
+
+/// Sweep `model` at `level` with the observer, then evaluate every point again and compare.
+fn check(model: &NonlinearModel, force: &[f64], level: f64, band_hz: (f64, f64)) -> usize {
+    let settings = HbmSettings { harmonics: 7, samples: 300 };
+    let n = model.linear.n_dofs();
+    let mut hbm = CondensedHbm::new(model, force, settings).unwrap();
+    let hill = Hill::new(hbm.receptance(), HillSettings::for_band(7, TWO_PI * band_hz.1)).unwrap();
+    let outputs = vec![OutputSelector { name: "tip".into(), vector: (0..n).map(|i| f64::from(i == n - 1)).collect() }];
+    let mut taken = Taken {
+        hill: &hill,
+        outputs: outputs.clone(),
+        results: Vec::new(),
+        stabilities: Vec::new(),
+        jacobians: Vec::new(),
+        fractions: Vec::new(),
+    };
+    let (w0, w1) = (TWO_PI * band_hz.0, TWO_PI * band_hz.1);
+    let branch = sweep_frequency(&mut hbm, level, w0, w1, &Options::default(), &mut taken).unwrap();
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    assert_eq!(taken.results.len(), branch.points.len());
+    assert!(taken.fractions.windows(2).all(|f| f[0] <= f[1]) && taken.fractions.last() == Some(&1.0));
+
+    // The same points evaluated again, one by one, as a run did before the observers had them.
+    let dim = hbm.dimension();
+    let mut slips = 0;
+    for (i, p) in branch.points.iter().enumerate() {
+        let again = evaluate_point(&mut hbm, &p.x, p.lambda, level, &outputs).unwrap();
+        let got = &taken.results[i];
+        // Bit for bit: the same AFT of the same x at the same Ω, the same recovery.
+        assert_eq!(got.outputs[0].coeffs, again.outputs[0].coeffs, "point {i}");
+        assert_eq!(got.outputs[0].displacement, again.outputs[0].displacement, "point {i}");
+        assert_eq!(got.excitation_work, again.excitation_work, "point {i}");
+        for (a, b) in got.elements.iter().zip(&again.elements) {
+            assert_eq!(a.energy_per_cycle, b.energy_per_cycle, "point {i}");
+            assert_eq!(a.stick_fraction, b.stick_fraction, "point {i}");
+            assert_eq!(a.force, b.force, "point {i}");
+        }
+        slips += usize::from(got.elements.iter().any(|e| e.stick_fraction < 1.0));
+
+        // The Jacobian completed from the converged residual against a full evaluation: the
+        // sliders' closed form from the same slip flags and the same matrices H_k, so the same
+        // numbers bit for bit (measured; any reordering of the sums would show here).
+        let mut r = vec![0.0; dim];
+        let (mut dx, mut dl) = (Mat::<f64>::zeros(dim, dim), vec![0.0; dim]);
+        let jacobians = Jacobians { dx: dx.as_mut(), domega: Some(&mut dl), dlevel: None };
+        hbm.evaluate(&p.x, p.lambda, level, &mut r, Some(jacobians)).unwrap();
+        let (cdx, cdl) = &taken.jacobians[i];
+        assert!(dx == *cdx, "point {i}: ∂R/∂x differs");
+        assert_eq!(&dl, cdl, "point {i}: ∂R/∂Ω differs");
+
+        // Stability from the completed joints' Jacobian against one evaluated again: the same
+        // matrix, so the same exponents bit for bit.
+        let fresh = stability_at(&mut hbm, &hill, &p.x, p.lambda).unwrap();
+        assert_eq!(taken.stabilities[i].exponents, fresh.exponents, "point {i}");
+    }
+    // The sweep crosses stick and slip, where the completion has work to do.
+    assert!(slips > 10, "{slips} points slip");
+    branch.points.len()
+}
+
+#[test]
+fn observers_get_each_point_as_evaluating_it_again_would_on_table6() {
+    for level in [300.0, 3000.0] {
+        assert!(check(&common::table6(), &[1.0], level, (150.0, 350.0)) > 30);
+    }
+}
+
+#[test]
+fn observers_get_each_point_as_evaluating_it_again_would_on_a_chain_with_four_joints() {
+    let model = common::chain_with_joints(20, 4, false);
+    let mut force = vec![0.0; 20];
+    force[19] = 1.0;
+    // The chain's first mode is near 238 Hz like the paper's (benches/common).
+    assert!(check(&model, &force, 2910.0, (170.0, 300.0)) > 30);
+}
+
+#[test]
+fn a_plain_observer_still_sees_every_point() {
+    let settings = HbmSettings { harmonics: 7, samples: 300 };
+    let model = common::table6();
+    let mut hbm = CondensedHbm::new(&model, &[1.0], settings).unwrap();
+    let mut seen = 0;
+    let branch =
+        sweep_frequency(&mut hbm, 1000.0, TWO_PI * 150.0, TWO_PI * 350.0, &Options::default(), &mut |_: &_, _| {
+            seen += 1
+        })
+        .unwrap();
+    assert_eq!(seen, branch.points.len());
+    let silent = sweep_frequency(&mut hbm, 1000.0, TWO_PI * 150.0, TWO_PI * 350.0, &Options::default(), &mut Silent);
+    assert_eq!(silent.unwrap().points, branch.points);
+}
