@@ -23,6 +23,6 @@ pub use full::FullHbm;
 pub use nonlinear_mode::{
     nonlinear_mode, Backbone, BackbonePoint, NegativeDamping, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
 };
-pub use receptance::Receptance;
+pub use receptance::{HarmonicReceptance, LinearParameter, LinearVariation, ModalReceptance, Receptance};
 pub use stability::{Hill, HillSettings, Refined, Stability, StabilityError};
 pub use sweep::{off_resonance, sweep_frequency, sweep_level, FrequencySweep, LevelSweep, SweepError};

@@ -56,6 +56,7 @@ use super::condensed::HbmSettings;
 use super::element_aft::AftError;
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
+use super::receptance::{LinearParameter, LinearVariation, ModalReceptance, Receptance};
 use crate::continuation::{
     continue_branch, Branch, ContinuationError, Options, PointObserver, Problem, ProblemError, Scales,
     TerminationReason,
@@ -102,11 +103,9 @@ pub struct NonlinearMode<'m> {
     omega_t: f64,
     c_t: f64,
     a_t: Vec<f64>,
-    /// Every mode (frequencies, damping, `Vᵀ Φ` q × m) and the mode shapes for recovery.
-    omega_r: Vec<f64>,
-    c_r: Vec<f64>,
-    a: Mat<f64>,
-    shapes: Mat<f64>,
+    /// The linear part: every mode (frequencies, damping, `A = Vᵀ Φ` q × m, the shapes for
+    /// recovery), as the forced balance has it.
+    linear: ModalReceptance,
     /// The condensed modes see `−ξ` too ([`NegativeDamping::MassProportional`]).
     shift_all: bool,
     q: usize,
@@ -276,23 +275,17 @@ impl<'m> NonlinearMode<'m> {
         if !model.linear.damping.is_modal() {
             return Err(NonlinearModeError::GeneralDamping);
         }
-        let modes = model.linear.dense_modes()?;
-        let m = modes.omega.len();
+        let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
+        let q = directions.len();
+        let unforced = vec![0.0; model.linear.n_dofs()];
+        let Receptance::Modal(linear) = Receptance::new(&model.linear, &directions, &unforced)? else {
+            return Err(NonlinearModeError::GeneralDamping);
+        };
+        let m = linear.natural_frequencies().len();
         if settings.mode >= m {
             return Err(NonlinearModeError::ModeOutOfRange { mode: settings.mode + 1, available: m });
         }
         let plan = AftPlan::new(settings.hbm.harmonics, settings.hbm.samples)?;
-        let n = model.linear.n_dofs();
-        let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
-        let q = directions.len();
-        let phi = &modes.shapes;
-        let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
-        let c_r: Vec<f64> = modes
-            .omega
-            .iter()
-            .enumerate()
-            .map(|(r, &w)| model.linear.damping.modal_coefficient(r, w).expect("modal damping"))
-            .collect();
         let target = settings.mode;
         let nc = plan.n_coeffs();
         let joints = JointForces::new(model, &plan);
@@ -301,13 +294,10 @@ impl<'m> NonlinearMode<'m> {
         Ok(NonlinearMode {
             model,
             target,
-            omega_t: modes.omega[target],
-            c_t: c_r[target],
-            a_t: (0..q).map(|i| a[(i, target)]).collect(),
-            omega_r: modes.omega.clone(),
-            c_r,
-            a,
-            shapes: modes.shapes,
+            omega_t: linear.natural_frequencies()[target],
+            c_t: linear.damping_coefficients()[target],
+            a_t: (0..q).map(|i| linear.participation()[(i, target)]).collect(),
+            linear,
             shift_all: settings.negative_damping == NegativeDamping::MassProportional,
             q,
             joints,
@@ -392,41 +382,31 @@ impl<'m> NonlinearMode<'m> {
         self.joints.evaluate(self.model, &self.plan, &self.u, omega, want)
     }
 
-    /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives (modal sum over every mode but the target).
+    /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives in Ω and ξ: the linear part with the
+    /// target mode left out and, for [`NegativeDamping::MassProportional`], the damping
+    /// `−ξ M` added ([`ModalReceptance::matrix_with`]; `∂/∂Ω = k ∂/∂ω`, `∂/∂ξ = −∂/∂α`).
     fn receptances(&mut self, omega: f64, xi: f64) {
-        let q = self.q;
-        let (xi, xi_weight) = if self.shift_all { (xi, 1.0) } else { (0.0, 0.0) };
+        let variation = LinearVariation {
+            mass_damping: if self.shift_all { -xi } else { 0.0 },
+            stiffness_damping: 0.0,
+            without_mode: Some(self.target),
+        };
+        let parameters: &[LinearParameter] = match self.shift_all {
+            true => &[LinearParameter::Frequency, LinearParameter::MassDamping],
+            false => &[LinearParameter::Frequency],
+        };
         for k in 0..=self.plan.n_harmonics() {
             let kf = k as f64;
-            let w = kf * omega;
-            let (h, dw, dx) = (&mut self.h[k], &mut self.dh_domega[k], &mut self.dh_dxi[k]);
-            h.fill(c64::new(0.0, 0.0));
-            dw.fill(c64::new(0.0, 0.0));
-            dx.fill(c64::new(0.0, 0.0));
-            for r in 0..self.omega_r.len() {
-                if r == self.target {
-                    continue;
-                }
-                let c = self.c_r[r] - xi;
-                let den = c64::new(self.omega_r[r] * self.omega_r[r] - w * w, w * c);
-                let inv = den.inv();
-                let inv2 = inv * inv;
-                // ∂(1/den)/∂Ω = k (2ω − i(c_r − ξ)) / den², ∂(1/den)/∂ξ = iω / den² (ω = kΩ).
-                let d_omega = c64::new(2.0 * w, -c) * inv2 * kf;
-                let d_xi = c64::new(0.0, w * xi_weight) * inv2;
-                for i in 0..q {
-                    let ai = self.a[(i, r)];
-                    if ai == 0.0 {
-                        continue;
-                    }
-                    for j in 0..q {
-                        let aa = ai * self.a[(j, r)];
-                        h[(i, j)] += inv * aa;
-                        dw[(i, j)] += d_omega * aa;
-                        dx[(i, j)] += d_xi * aa;
-                    }
+            let (h, dw, dx) = (self.h[k].as_mut(), &mut self.dh_domega[k], &mut self.dh_dxi[k]);
+            match self.shift_all {
+                true => self.linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut(), dx.as_mut()]),
+                false => {
+                    self.linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut()]);
+                    dx.fill(c64::new(0.0, 0.0));
                 }
             }
+            dw.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v *= kf);
+            dx.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v = -*v);
         }
     }
 
@@ -440,9 +420,11 @@ impl<'m> NonlinearMode<'m> {
             .map_err(|e| NonlinearModeError::PostProcessing { amplitude, reason: e.message })?;
         let q = self.q;
         let (nh, nc, nt) = (self.plan.n_harmonics(), self.plan.n_coeffs(), self.plan.n_samples());
-        let m = self.omega_r.len();
+        let m = self.linear.natural_frequencies().len();
         let n = self.model.linear.n_dofs();
         let pi = std::f64::consts::PI;
+        let (omega_r, c_r) = (self.linear.natural_frequencies(), self.linear.damping_coefficients());
+        let (a, shapes) = (self.linear.participation(), &self.linear.modes().shapes);
         // Modal coordinates of every mode, harmonic by harmonic: η for the target,
         // −a_rᵀ G_k / den_r(kΩ) for the others (the condensed modes, recovered).
         let mut modal = vec![vec![c64::new(0.0, 0.0); nh + 1]; m];
@@ -466,8 +448,8 @@ impl<'m> NonlinearMode<'m> {
                     }
                 } else {
                     let shift = if self.shift_all { xi } else { 0.0 };
-                    let den = c64::new(self.omega_r[r] * self.omega_r[r] - w * w, w * (self.c_r[r] - shift));
-                    let load: c64 = (0..q).map(|i| gk[i] * self.a[(i, r)]).sum();
+                    let den = c64::new(omega_r[r] * omega_r[r] - w * w, w * (c_r[r] - shift));
+                    let load: c64 = (0..q).map(|i| gk[i] * a[(i, r)]).sum();
                     -load / den
                 };
             }
@@ -480,7 +462,7 @@ impl<'m> NonlinearMode<'m> {
             if self.shift_all || r == self.target {
                 supplied += xi * s;
             }
-            viscous += self.c_r[r] * s;
+            viscous += c_r[r] * s;
         }
         let mut joint_energy = Vec::with_capacity(self.model.elements.len());
         let mut stick_fraction = Vec::with_capacity(self.model.elements.len());
@@ -505,7 +487,7 @@ impl<'m> NonlinearMode<'m> {
         let outputs = outputs
             .iter()
             .map(|o| {
-                let proj: Vec<f64> = (0..m).map(|r| (0..n).map(|l| o[l] * self.shapes[(l, r)]).sum()).collect();
+                let proj: Vec<f64> = (0..m).map(|r| (0..n).map(|l| o[l] * shapes[(l, r)]).sum()).collect();
                 let mut c = vec![0.0; nc];
                 for k in 0..=nh {
                     let v: c64 = (0..m).map(|r| modal[r][k] * proj[r]).sum();
@@ -807,7 +789,7 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
         notes: Vec::new(),
         branch: Some(branch),
         viscous: problem.c_t,
-        shape: problem.shapes.col(settings.mode).iter().copied().collect(),
+        shape: problem.linear.modes().shapes.col(settings.mode).iter().copied().collect(),
     })
 }
 

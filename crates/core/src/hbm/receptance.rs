@@ -23,7 +23,7 @@
 
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
-use faer::{c64, Accum, Mat, MatRef, Par};
+use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
 
 use crate::model::{Damping, LinearModel, ModelError, Modes};
 
@@ -67,6 +67,30 @@ pub struct DirectReceptance {
     damping: Mat<f64>,
     /// `[V F]` (n × (q+1)).
     rhs: Mat<c64>,
+}
+
+/// A parameter of the linear part with respect to which [`ModalReceptance::matrix_with`]
+/// differentiates `H`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinearParameter {
+    /// The harmonic's circular frequency ω (rad/s): `∂(1/den_r)/∂ω = (2ω − i c_r)/den_r²`.
+    Frequency,
+    /// α of a damping `α M` added to the model's: every modal coefficient `c_r → c_r + α`,
+    /// `∂(1/den_r)/∂α = −iω/den_r²`. The negative damping `−ξ M` of a nonlinear mode (EPMC,
+    /// Krack 2015, Eq. 2) is `α = −ξ`.
+    MassDamping,
+    /// β of a damping `β K` added: `c_r → c_r + β ω_r²`, `∂(1/den_r)/∂β = −iω ω_r²/den_r²`.
+    StiffnessDamping,
+}
+
+/// A variation of the linear part: damping `α M + β K` added to the model's, and a mode left
+/// out of the modal sum (the target mode of a nonlinear mode, whose coordinate is kept as an
+/// unknown).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinearVariation {
+    pub mass_damping: f64,
+    pub stiffness_damping: f64,
+    pub without_mode: Option<usize>,
 }
 
 /// Output selectors prepared by [`Receptance::outputs`].
@@ -295,6 +319,57 @@ impl ModalReceptance {
     /// The mass-normalised modes of the linear model.
     pub fn modes(&self) -> &Modes {
         &self.modes
+    }
+
+    /// Modal damping coefficients under `variation`: `c_r + α + β ω_r²`.
+    pub fn varied_damping(&self, r: usize, variation: &LinearVariation) -> f64 {
+        self.c_r[r] + variation.mass_damping + variation.stiffness_damping * self.omega_r2[r]
+    }
+
+    /// `H(ω) = Σ_r a_r a_rᵀ / den_r(ω)` of the model under `variation` (`den_r = ω_r² − ω² +
+    /// iω c_r'`, `c_r'` from [`Self::varied_damping`], the mode it leaves out skipped) into
+    /// `h`, and its derivative with respect to each of `parameters` into `derivatives` (same
+    /// order, q × q each): the linear part of a formulation whose unknowns or continuation
+    /// parameter enter the linear dynamics (the frequency and the negative damping of a
+    /// nonlinear mode). O(q² m).
+    pub fn matrix_with(
+        &self,
+        omega: f64,
+        variation: &LinearVariation,
+        parameters: &[LinearParameter],
+        mut h: MatMut<'_, c64>,
+        derivatives: &mut [MatMut<'_, c64>],
+    ) {
+        let q = self.a.nrows();
+        let mut weights = [c64::new(0.0, 0.0); 3];
+        assert!(parameters.len() <= weights.len() && derivatives.len() == parameters.len(), "one matrix per parameter");
+        h.fill(c64::new(0.0, 0.0));
+        derivatives.iter_mut().for_each(|d| d.fill(c64::new(0.0, 0.0)));
+        for r in (0..self.omega_r.len()).filter(|&r| Some(r) != variation.without_mode) {
+            let c = self.varied_damping(r, variation);
+            let inv = c64::new(self.omega_r2[r] - omega * omega, omega * c).inv();
+            let inv2 = inv * inv;
+            for (w, parameter) in weights.iter_mut().zip(parameters) {
+                *w = match parameter {
+                    LinearParameter::Frequency => c64::new(2.0 * omega, -c) * inv2,
+                    LinearParameter::MassDamping => c64::new(0.0, -omega) * inv2,
+                    LinearParameter::StiffnessDamping => c64::new(0.0, -omega * self.omega_r2[r]) * inv2,
+                };
+            }
+            for i in 0..q {
+                let ai = self.a[(i, r)];
+                if ai == 0.0 {
+                    continue;
+                }
+                for j in 0..q {
+                    let aa = ai * self.a[(j, r)];
+                    h[(i, j)] += inv * aa;
+                    for (d, w) in derivatives.iter_mut().zip(&weights) {
+                        d[(i, j)] += w * aa;
+                    }
+                }
+            }
+        }
     }
 
     /// The modal weights `1/den_r` and their ω-derivatives, with `force` `u_F` and its
