@@ -72,7 +72,8 @@ pub const FACTOR_BY_STRUCTURE_FROM: usize = 500;
 /// The condensed harmonic balance of a [`NonlinearModel`] under `λ_F F cos Ωt`.
 pub struct CondensedHbm<'m> {
     model: &'m NonlinearModel,
-    plan: AftPlan,
+    /// The Fourier plan, shared with the balances sharing the linear part.
+    plan: Arc<AftPlan>,
     /// The linear part, shared by the balances of one model and excitation
     /// ([`Self::share_linear_part`]).
     receptance: Arc<Receptance>,
@@ -110,39 +111,37 @@ impl<'m> CondensedHbm<'m> {
         }
         let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
         let receptance = Arc::new(Receptance::new(&model.linear, &directions, force)?);
-        Self::with_receptance(model, force, settings, receptance)
+        let plan = Arc::new(AftPlan::new(settings.harmonics, settings.samples)?);
+        Ok(Self::with_receptance(model, force, plan, receptance))
     }
 
     /// A balance of the same model, excitation and settings that shares this one's linear part
-    /// (the receptance: the model's modes, the costly part of [`Self::new`]) and has state of
-    /// its own: what the force levels of a study, swept one per thread, have in common. It
-    /// evaluates exactly as a balance made by [`Self::new`].
+    /// (the receptance: the model's modes, the costly part of [`Self::new`]) and its Fourier
+    /// plan, and has state of its own: what the force levels of a study, swept one per
+    /// thread, have in common. It evaluates exactly as a balance made by [`Self::new`].
     pub fn share_linear_part(&self) -> Self {
-        let settings = HbmSettings { harmonics: self.plan.n_harmonics(), samples: self.plan.n_samples() };
-        Self::with_receptance(self.model, &self.force, settings, Arc::clone(&self.receptance))
-            .expect("the settings of a balance that was set up")
+        Self::with_receptance(self.model, &self.force, Arc::clone(&self.plan), Arc::clone(&self.receptance))
     }
 
     fn with_receptance(
         model: &'m NonlinearModel,
         force: &[f64],
-        settings: HbmSettings,
+        plan: Arc<AftPlan>,
         receptance: Arc<Receptance>,
-    ) -> Result<Self, HbmError> {
-        let plan = AftPlan::new(settings.harmonics, settings.samples)?;
+    ) -> Self {
         let q = receptance.n_directions();
         let joints = JointForces::new(model, &plan);
         // Static receptance H(0) = Vᵀ K⁻¹ V (real).
         let mut h = HarmonicReceptance::new(q);
         receptance.evaluate_matrix(0.0, &mut h);
         let h0 = Mat::from_fn(q, q, |i, j| h.h[(i, j)].re);
-        Ok(CondensedHbm {
+        CondensedHbm {
             model,
             receptance,
             force: force.to_vec(),
             q,
             joints,
-            harmonic: (0..settings.harmonics).map(|_| HarmonicReceptance::new(q)).collect(),
+            harmonic: (0..plan.n_harmonics()).map(|_| HarmonicReceptance::new(q)).collect(),
             h0,
             amplitudes: vec![c64::new(0.0, 0.0); q],
             product: vec![c64::new(0.0, 0.0); q],
@@ -158,7 +157,7 @@ impl<'m> CondensedHbm<'m> {
             last: None,
             plan,
             evaluations: 0,
-        })
+        }
     }
 
     /// Number of unknowns (2N+1)q.
