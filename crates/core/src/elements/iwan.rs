@@ -1,7 +1,7 @@
 use super::{check_positive, Element, ElementError, Tangent};
 
 /// Iwan element: Jenkins elements in parallel with a distribution of slip thresholds, for
-/// microslip (Iwan 1966, paper ref. [32]). Slider `i` has stiffness `k_i` and threshold
+/// microslip (Iwan 1966, paper ref. \[32\]). Slider `i` has stiffness `k_i` and threshold
 /// `F_i`; the element force is `Σ f_i`, so the response softens gradually from the stuck
 /// stiffness `Σ k_i` to zero as sliders break loose one after the other.
 ///

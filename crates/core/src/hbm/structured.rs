@@ -22,7 +22,7 @@
 //!
 //! **Iterative reduced system.** When every direction of a large patch slips or opens in the
 //! period, `M` is the whole `(2N+1) q` system and its dense LU the whole cost (1.7 s at q = 300,
-//! N = 7). Above [`DIRECT_UP_TO`] unknowns `M` is not formed: `M u = y` is solved by BiCGSTAB
+//! N = 7). Above `DIRECT_UP_TO` unknowns `M` is not formed: `M u = y` is solved by BiCGSTAB
 //! (faer's `matrix_free::bicgstab`), `M` applied as `u + G (B_N u)` (`G = E_Nᵀ C`, block
 //! diagonal over harmonics; `B_N` block diagonal over elements), right-preconditioned by
 //! `P = I + G B̄` with `B̄` the part of `B_N` that does not couple harmonics, in complex form (the
