@@ -18,7 +18,7 @@ use stickslip_core::hbm::{
     NegativeDamping, NonlinearModeError, NonlinearModeSettings, Stability, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
-use stickslip_core::post::{evaluate_point, point_result, OutputSelector, PointResult};
+use stickslip_core::post::{evaluate_point, output_amplitude, point_result, OutputSelector, PointResult};
 
 use crate::output::{
     harmonics_from_coefficients, BifurcationRecord, ElementRecord, JointSides, LevelResult, OutputRecord, Peak,
@@ -320,15 +320,14 @@ fn locate_peaks(
             peaks.push(sampled);
             continue;
         }
-        let one = std::slice::from_ref(selector);
+        let prepared = hbm.receptance().outputs(&[&selector.vector]);
         let mut problem = FrequencySweep { hbm, level };
         let bracket = brackets.entry(i).or_insert_with(|| {
             Bracket::new(&mut problem, [&branch.points[i - 1], &branch.points[i], &branch.points[i + 1]]).ok()
         });
         let found = bracket.as_mut().map(|bracket| {
             bracket.maximise(&mut problem, PEAK_TOLERANCE, |p, x, omega| {
-                let r = evaluate_point(p.hbm, x, omega, level, one).map_err(|e| ProblemError::new(e.to_string()))?;
-                Ok(r.outputs[0].harmonic(1).0)
+                output_amplitude(p.hbm, x, omega, level, &prepared, 1).map_err(|e| ProblemError::new(e.to_string()))
             })
         });
         peaks.push(match found {

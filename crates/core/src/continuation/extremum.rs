@@ -48,6 +48,9 @@ const WINDOW: f64 = 0.15;
 /// Points within this distance of the last ones solved start from them (two lattice
 /// spacings and a half: the scan's next point, Brent's steps).
 const NEAR: f64 = 2.5 * SCAN_SPACING;
+/// A point is converged when its residual is at most this fraction of its unknowns' norm
+/// (`R = x − λ u_F + H G` is a difference of terms of the size of x: ~1000 ulps of them).
+const ROUND_OFF: f64 = 1e-13;
 /// The scanned arcs that are maximised: those whose best scanned point is within this fraction
 /// of the best. The tops of a friction peak's arcs differ by 1e-5 to 1e-4 near the maximum, a
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
@@ -379,12 +382,30 @@ impl ChordPath {
         // Residuals relative to their change across the bracket, ‖∂R/∂λ‖ s_λ (set at the first
         // evaluation), so that the rows of the bordered matrix are of one magnitude.
         let mut residual_scale = 0.0;
-        for _ in 0..MAX_ITERATIONS {
+        let lazy = self.workspace.lazy;
+        for iteration in 0..MAX_ITERATIONS {
             for (xi, zi) in self.x.iter_mut().zip(z.iter()) {
                 *xi = zi * self.x_scale;
             }
             let lambda = z[n] * self.lambda_scale;
-            match self.workspace.evaluate(problem, &self.x, lambda, true) {
+            // A problem that completes residuals to Jacobians: the residual first, the Jacobian
+            // only if the iterate is not converged.
+            let evaluated = self.workspace.evaluate(problem, &self.x, lambda, !lazy || iteration == 0);
+            // Converged to round-off: the residual is down to a thousand ulps of the unknowns.
+            // A friction residual is piecewise affine in x, so one step from a guess on the
+            // same arc lands there, and this saves the Jacobian and solve that would only
+            // show a negligible update.
+            if evaluated.is_ok() && iteration > 0 {
+                let r = self.workspace.residual.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if r <= ROUND_OFF * self.x.iter().map(|v| v * v).sum::<f64>().sqrt() {
+                    return Ok(true);
+                }
+            }
+            let evaluated = match evaluated {
+                Ok(()) if lazy && iteration > 0 => self.workspace.complete(problem),
+                other => other,
+            };
+            match evaluated {
                 Ok(()) => {}
                 // A law that fails on this iterate: the point cannot be solved, not the search.
                 Err(e) if e.at_trial_iterate => return Ok(false),

@@ -60,7 +60,7 @@ pub enum HbmError {
     NoConvergence { frequency_hz: f64, level: f64, iterations: usize, residual: f64 },
     #[error("the excitation pattern has length {got}, expected {expected}")]
     ForceLength { got: usize, expected: usize },
-    #[error("the balance has not been evaluated: there is no solution to post-process")]
+    #[error("the balance was not last evaluated at the solution to post-process")]
     NotEvaluated,
 }
 
@@ -93,8 +93,10 @@ pub struct CondensedHbm<'m> {
     /// Every element is a slider, whose Jacobian follows from a residual evaluation's slip
     /// flags ([`Self::complete_jacobian`]).
     sliders_only: bool,
-    /// Ω and λ_F of the last evaluation.
+    /// Ω and λ_F of the last evaluation, and its x (what post-processing reads is that
+    /// evaluation's: [`Self::evaluated_at`]).
     last: Option<(f64, f64)>,
+    last_x: Vec<f64>,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -155,6 +157,7 @@ impl<'m> CondensedHbm<'m> {
                     && !law.depends_on_velocity()
             }),
             last: None,
+            last_x: vec![0.0; q * plan.n_coeffs()],
             plan,
             evaluations: 0,
         }
@@ -297,6 +300,7 @@ impl<'m> CondensedHbm<'m> {
             }
         }
         self.last = Some((omega, level));
+        self.last_x.copy_from_slice(x);
         Ok(())
     }
 
@@ -537,12 +541,28 @@ impl<'m> CondensedHbm<'m> {
         self.last
     }
 
-    /// [`Self::element_force_jacobian`] at the solution `x`, Ω of the last evaluation (a
-    /// continuation's converged one, made for the residual alone): completed from its slip
-    /// flags when every element is a slider ([`JointForces::complete_jacobian`]), else
-    /// evaluated at `x` again.
+    /// Was the last evaluation (which succeeded) at exactly `x`, Ω, λ_F? Then the element
+    /// forces and time samples it left are those of this point.
+    pub fn evaluated_at(&self, x: &[f64], omega: f64, level: f64) -> bool {
+        self.last == Some((omega, level)) && self.last_x == x
+    }
+
+    /// Evaluate the residual at `x`, Ω, λ_F unless the last evaluation was there: the element
+    /// forces of that point for post-processing.
+    pub fn evaluate_unless_at(&mut self, x: &[f64], omega: f64, level: f64) -> Result<(), HbmError> {
+        if !self.evaluated_at(x, omega, level) {
+            let mut residual = vec![0.0; self.dimension()];
+            self.evaluate(x, omega, level, &mut residual, None)?;
+        }
+        Ok(())
+    }
+
+    /// [`Self::element_force_jacobian`] at the solution `x`, Ω: when the last evaluation was
+    /// there (a continuation's converged one, made for the residual alone) and every element
+    /// is a slider, completed from its slip flags ([`JointForces::complete_jacobian`]), else
+    /// evaluated at `x`.
     pub fn element_force_jacobian_at_last(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
-        let here = self.last.is_some_and(|(w, _)| w == omega);
+        let here = self.last.is_some_and(|(w, _)| w == omega) && self.last_x == x;
         if !(here && self.sliders_only && self.joints.complete_jacobian(self.model, &self.plan)) {
             return self.element_force_jacobian(x, omega);
         }

@@ -6,6 +6,7 @@ use faer::c64;
 
 use crate::hbm::condensed::{complex_amplitude, CondensedHbm, HbmError};
 use crate::hbm::fourier::{amplitude_phase, cos_index, sin_index};
+use crate::hbm::receptance::Outputs;
 
 /// A quantity to report: a name and the vector `o` such that the reported motion is `oᵀ U`
 /// (a unit vector for a DOF).
@@ -99,18 +100,37 @@ pub fn evaluate_point(
     level: f64,
     outputs: &[OutputSelector],
 ) -> Result<PointResult, HbmError> {
-    let mut residual = vec![0.0; hbm.dimension()];
     // Fills the elements' time samples and force harmonics at x.
-    hbm.evaluate(x, omega, level, &mut residual, None)?;
+    hbm.evaluate_unless_at(x, omega, level)?;
     point_result(hbm, x, outputs)
+}
+
+/// Amplitude of harmonic `k ≥ 1` of the output prepared in `output` (one selector of
+/// [`crate::hbm::Receptance::outputs`]) at the solution `x` of `hbm` at (Ω, λ_F): the quantity a
+/// located peak maximises, recovered alone (Eq. 27 at one harmonic, no time series).
+pub fn output_amplitude(
+    hbm: &mut CondensedHbm<'_>,
+    x: &[f64],
+    omega: f64,
+    level: f64,
+    output: &Outputs,
+    k: usize,
+) -> Result<f64, HbmError> {
+    hbm.evaluate_unless_at(x, omega, level)?;
+    let q = hbm.n_directions();
+    let g = hbm.element_force_harmonics();
+    let gk: Vec<c64> = (0..q).map(|i| complex_amplitude(g, q, k, i)).collect();
+    let lk = if k == 1 { level } else { 0.0 };
+    let (amplitudes, _) = hbm.receptance().recover(k as f64 * omega, lk, &gk, output);
+    Ok(amplitudes[0].norm())
 }
 
 /// Post-process the solution `x` at which `hbm` was last evaluated (the converged evaluation
 /// of a continuation, handed to its observer): the elements' forces and time samples are
-/// read as that evaluation left them, not computed again. An error if `hbm` was never
-/// evaluated.
+/// read as that evaluation left them, not computed again. An error if the last evaluation
+/// was not at `x`.
 pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector]) -> Result<PointResult, HbmError> {
-    let Some((omega, level)) = hbm.last_evaluation() else {
+    let Some((omega, level)) = hbm.last_evaluation().filter(|&(w, l)| hbm.evaluated_at(x, w, l)) else {
         return Err(HbmError::NotEvaluated);
     };
     let q = hbm.n_directions();
