@@ -163,6 +163,35 @@ impl DlftHbm {
         settings: HbmSettings,
         epsilon: f64,
     ) -> Result<Self, HbmError> {
+        let receptance = Arc::new(Self::receptance_of(linear, contacts, force)?);
+        Self::with_receptance(contacts, force, settings, epsilon, receptance)
+    }
+
+    /// The balance of a model of rigid contacts ([`NonlinearModel::with_rigid_contacts`]), which
+    /// must have no other element (DLFT imposes the contacts' constraints only), with the
+    /// default ε at `omega` (rad/s, [`DlftHbm::default_epsilon`]; collocated, the solution does
+    /// not depend on it).
+    pub fn for_model(
+        model: &NonlinearModel,
+        force: &[f64],
+        settings: HbmSettings,
+        omega: f64,
+    ) -> Result<Self, HbmError> {
+        if let Some(e) = model.elements.first() {
+            return Err(HbmError::Model(ModelError::Invalid(format!(
+                "the DLFT balance solves rigid contacts only, and the model has the element {:?} ({})",
+                e.name,
+                e.law.kind()
+            ))));
+        }
+        let contacts = &model.rigid_contacts;
+        let receptance = Arc::new(Self::receptance_of(&model.linear, contacts, force)?);
+        let epsilon = mean_dynamic_stiffness(&receptance, omega);
+        Self::with_receptance(contacts, force, settings, epsilon, receptance)
+    }
+
+    /// The receptance on the contacts' directions, after checking their number and lengths.
+    fn receptance_of(linear: &LinearModel, contacts: &[RigidContact], force: &[f64]) -> Result<Receptance, HbmError> {
         let n = linear.n_dofs();
         if force.len() != n {
             return Err(HbmError::ForceLength { got: force.len(), expected: n });
@@ -170,21 +199,14 @@ impl DlftHbm {
         if contacts.is_empty() {
             return Err(HbmError::NoElements);
         }
-        let invalid = |m: String| HbmError::Model(ModelError::Invalid(m));
-        if !(epsilon.is_finite() && epsilon > 0.0) {
-            return Err(invalid(format!("DLFT: epsilon must be a finite number > 0 (N/m), got {epsilon}")));
-        }
-        let mut laws = Vec::with_capacity(contacts.len());
-        let mut offsets = Vec::with_capacity(contacts.len());
-        let mut q = 0;
         for c in contacts {
-            let element_error = |e: ElementError| invalid(format!("contact {:?}: {e}", c.name));
-            let law = match c.directions.len() {
-                2 => Contact::new_2d(epsilon, epsilon, c.friction, c.preload),
-                3 => Contact::new_3d(epsilon, epsilon, c.friction, c.preload),
-                d => return Err(invalid(format!("contact {:?}: needs 2 or 3 application vectors, got {d}", c.name))),
+            if !matches!(c.directions.len(), 2 | 3) {
+                return Err(HbmError::Model(ModelError::Invalid(format!(
+                    "contact {:?}: needs 2 or 3 application vectors, got {}",
+                    c.name,
+                    c.directions.len()
+                ))));
             }
-            .map_err(element_error)?;
             for v in &c.directions {
                 if v.len() != n {
                     return Err(HbmError::Model(ModelError::WrongLength {
@@ -194,31 +216,9 @@ impl DlftHbm {
                     }));
                 }
             }
-            offsets.push(q);
-            q += c.directions.len();
-            laws.push(law);
         }
         let directions: Vec<&[f64]> = contacts.iter().flat_map(|c| c.directions.iter().map(|v| v.as_slice())).collect();
-        let receptance = Arc::new(Receptance::new(linear, &directions, force)?);
-        Self::with_receptance(contacts, force, settings, epsilon, laws, offsets, q, receptance)
-    }
-
-    /// The balance of a model of rigid contacts ([`NonlinearModel::with_rigid_contacts`]), which
-    /// must have no other element (DLFT imposes the contacts' constraints only).
-    pub fn for_model(
-        model: &NonlinearModel,
-        force: &[f64],
-        settings: HbmSettings,
-        epsilon: f64,
-    ) -> Result<Self, HbmError> {
-        if let Some(e) = model.elements.first() {
-            return Err(HbmError::Model(ModelError::Invalid(format!(
-                "the DLFT balance solves rigid contacts only, and the model has the element {:?} ({})",
-                e.name,
-                e.law.kind()
-            ))));
-        }
-        Self::new(&model.linear, &model.rigid_contacts, force, settings, epsilon)
+        Ok(Receptance::new(linear, &directions, force)?)
     }
 
     /// A balance of the same contacts, excitation, settings and ε that shares this one's linear
@@ -227,30 +227,36 @@ impl DlftHbm {
     /// balance made by [`Self::new`].
     pub fn share_linear_part(&self) -> Self {
         let settings = HbmSettings { harmonics: self.plan.n_harmonics(), samples: self.plan.n_samples() };
-        Self::with_receptance(
-            &self.contacts,
-            &self.force,
-            settings,
-            self.epsilon,
-            self.laws.clone(),
-            self.offsets.clone(),
-            self.q,
-            Arc::clone(&self.receptance),
-        )
-        .expect("the settings of a balance that was set up")
+        Self::with_receptance(&self.contacts, &self.force, settings, self.epsilon, Arc::clone(&self.receptance))
+            .expect("the settings of a balance that was set up")
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn with_receptance(
         contacts: &[RigidContact],
         force: &[f64],
         settings: HbmSettings,
         epsilon: f64,
-        laws: Vec<Contact>,
-        offsets: Vec<usize>,
-        q: usize,
         receptance: Arc<Receptance>,
     ) -> Result<Self, HbmError> {
+        let invalid = |m: String| HbmError::Model(ModelError::Invalid(m));
+        if !(epsilon.is_finite() && epsilon > 0.0) {
+            return Err(invalid(format!("DLFT: epsilon must be a finite number > 0 (N/m), got {epsilon}")));
+        }
+        let mut laws = Vec::with_capacity(contacts.len());
+        let mut offsets = Vec::with_capacity(contacts.len());
+        let mut q = 0;
+        for c in contacts {
+            let element_error = |e: ElementError| invalid(format!("contact {:?}: {e}", c.name));
+            let law = if c.directions.len() == 2 {
+                Contact::new_2d(epsilon, epsilon, c.friction, c.preload)
+            } else {
+                Contact::new_3d(epsilon, epsilon, c.friction, c.preload)
+            }
+            .map_err(element_error)?;
+            offsets.push(q);
+            q += c.directions.len();
+            laws.push(law);
+        }
         let plan = AftPlan::new(settings.harmonics, settings.samples)?;
         let nc = plan.n_coeffs();
         let dim = nc * q;
@@ -295,13 +301,7 @@ impl DlftHbm {
         force: &[f64],
         omega: f64,
     ) -> Result<f64, HbmError> {
-        let directions: Vec<&[f64]> = contacts.iter().flat_map(|c| c.directions.iter().map(|v| v.as_slice())).collect();
-        let receptance = Receptance::new(linear, &directions, force)?;
-        let q = directions.len();
-        let mut h = HarmonicReceptance::new(q);
-        receptance.evaluate_matrix(omega, &mut h);
-        let z = h.h.partial_piv_lu().inverse();
-        Ok((0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64)
+        Ok(mean_dynamic_stiffness(&Self::receptance_of(linear, contacts, force)?, omega))
     }
 
     /// `‖u_F(Ω)‖`: the contact directions' response to the force at unit level with the
@@ -695,6 +695,15 @@ fn problem_error(e: HbmError) -> ProblemError {
         HbmError::Aft(_) => ProblemError::at_trial_iterate(e.to_string()),
         _ => ProblemError::new(e.to_string()),
     }
+}
+
+/// The mean of `|Z_ii(Ω)|` at harmonic 1, `Z = H⁻¹` the condensed dynamic stiffness.
+fn mean_dynamic_stiffness(receptance: &Receptance, omega: f64) -> f64 {
+    let q = receptance.n_directions();
+    let mut h = HarmonicReceptance::new(q);
+    receptance.evaluate_matrix(omega, &mut h);
+    let z = h.h.partial_piv_lu().inverse();
+    (0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64
 }
 
 fn dot(row: faer::RowRef<'_, f64>, v: &[f64]) -> f64 {

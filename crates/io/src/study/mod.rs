@@ -218,16 +218,24 @@ pub enum LawSpec {
 }
 
 /// A point contact (`contact2d`: one tangential direction, `contact3d`: two), standalone: the
-/// joint adds its own stiffnesses. The joint's `placement` is its first tangential direction;
-/// `tangential` holds all of them, `normal` the normal approach.
+/// joint adds its own stiffnesses, or none when it is rigid. The joint's `placement` is its
+/// first tangential direction; `tangential` holds all of them, `normal` the normal approach.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSpec {
     pub tangential: Vec<Placement>,
     pub normal: Placement,
     pub preload: f64,
-    pub normal_stiffness: f64,
-    pub tangential_stiffness: f64,
+    /// The penalty stiffnesses; `None` for a rigid contact (`[harmonic_balance] contact_method
+    /// = "dlft"`).
+    pub stiffness: Option<ContactStiffness>,
     pub friction: f64,
+}
+
+/// The penalty stiffnesses of a point contact (N/m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactStiffness {
+    pub normal: f64,
+    pub tangential: f64,
 }
 
 /// A joint: a nonlinear element on an application vector.
@@ -310,12 +318,31 @@ pub struct HbmSettings {
     pub max_iterations: usize,
     /// Stability of every point by Hill's method, and the bifurcations (default false).
     pub stability: bool,
+    /// How contacts are solved (default: penalty elements).
+    pub contact_method: ContactMethod,
 }
 
 impl Default for HbmSettings {
     fn default() -> Self {
-        HbmSettings { harmonics: 7, samples: 300, tolerance: 1e-8, max_iterations: 20, stability: false }
+        HbmSettings {
+            harmonics: 7,
+            samples: 300,
+            tolerance: 1e-8,
+            max_iterations: 20,
+            stability: false,
+            contact_method: ContactMethod::Penalty,
+        }
     }
+}
+
+/// `[harmonic_balance] contact_method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactMethod {
+    /// Every joint is an element of the condensed balance; contacts have penalty stiffnesses.
+    Penalty,
+    /// Rigid contacts by the dynamic Lagrangian frequency-time method (core `hbm::dlft`): every
+    /// joint is a point contact without stiffness, sampled at `2N + 1` instants per period.
+    Dlft,
 }
 
 /// Predictor of the pseudo-arclength continuation.
