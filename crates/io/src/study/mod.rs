@@ -530,6 +530,22 @@ impl Study {
         validate::parse(text, path.as_ref())
     }
 
+    /// An error unless the study's contacts have stiffness: `what` (a time integration) needs
+    /// element forces that follow from the motion, which rigid contacts
+    /// (`contact_method = "dlft"`) have not.
+    pub fn require_penalty_contacts(&self, what: &str) -> Result<(), StudyError> {
+        match self.hbm.contact_method {
+            ContactMethod::Penalty => Ok(()),
+            ContactMethod::Dlft => Err(StudyError {
+                file: self.path.clone(),
+                location: None,
+                kind: Box::new(StudyErrorKind::Invalid(format!(
+                    "[harmonic_balance] contact_method = \"dlft\": {what} needs contacts with stiffness, and rigid contacts are solved by the harmonic balance only; for {what}, set contact_method = \"penalty\" and give each contact normal_stiffness and tangential_stiffness (N/m)"
+                ))),
+            }),
+        }
+    }
+
     /// Validate a study given as a table (e.g. a Python dict) rather than as text: the table
     /// is written as TOML and goes through [`Study::parse`], so the checks and their messages
     /// are those of a file. `path` names the study in errors and anchors its relative paths;
