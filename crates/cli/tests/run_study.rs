@@ -416,3 +416,22 @@ fn the_rigid_contact_example_writes_the_core_dlft_solution() {
         }
     }
 }
+
+/// The time integrator needs contact forces that follow from the motion: a study of rigid
+/// contacts is refused with the key that makes them rigid, before any model is built.
+#[test]
+fn timesim_refuses_rigid_contacts_naming_the_key() {
+    let out = scratch("rigid-timesim");
+    let output = stickslip()
+        .args(["timesim", "--frequency", "68.6", "--out"])
+        .arg(&out)
+        .arg(repo().join("examples/rigid-contact/study.toml"))
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("study.toml: [harmonic_balance] contact_method = \"dlft\": the time integration needs contacts with stiffness"),
+        "{stderr}"
+    );
+}
