@@ -222,7 +222,7 @@ impl<'m> Balance<'m> {
     fn frequency_problem(&mut self, level: f64) -> FrequencyProblem<'_, 'm> {
         match self {
             Balance::Penalty(hbm) => FrequencyProblem::Penalty(FrequencySweep { hbm, level }),
-            // The bracket's points come from the sweep, whose scale it keeps.
+            // The bracket scales x by its own three points, not by the problem's scales.
             Balance::Dlft(dlft) => FrequencyProblem::Dlft(DlftFrequencySweep { dlft, level, unknowns_scale: None }),
         }
     }
