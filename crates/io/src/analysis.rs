@@ -7,18 +7,22 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use faer::MatMut;
 use stickslip_core::continuation::{
-    Accepted, Bracket, Branch, Observer, Options, PointObserver, Predictor, ProblemError, Rejection, Silent,
-    TerminationReason,
+    Accepted, Bracket, Branch, FactoredJacobian, Observer, Options, PointObserver, Predictor, Problem, ProblemError,
+    Rejection, Scales, Silent, TerminationReason,
 };
 use stickslip_core::hbm::bifurcation::is_stable;
+use stickslip_core::hbm::dlft::{self, DlftFrequencySweep, DlftHbm};
 use stickslip_core::hbm::{
     bifurcations, nonlinear_mode, stability_at_last_evaluation, sweep_frequency, sweep_level, Backbone,
-    BranchStabilityError, CondensedHbm, FrequencySweep, HbmSettings as CoreHbmSettings, Hill, HillSettings,
+    BranchStabilityError, CondensedHbm, FrequencySweep, HbmError, HbmSettings as CoreHbmSettings, Hill, HillSettings,
     NegativeDamping, NonlinearModeError, NonlinearModeSettings, Stability, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
-use stickslip_core::post::{evaluate_point, output_amplitude, point_result, OutputSelector, PointResult};
+use stickslip_core::post::{
+    evaluate_dlft_point, evaluate_point, output_amplitude, point_result, OutputSelector, PointResult,
+};
 
 use crate::output::{
     harmonics_from_coefficients, BifurcationRecord, ElementRecord, JointSides, LevelResult, OutputRecord, Peak,
@@ -28,8 +32,8 @@ use crate::report::{
     number, peaks, JointSummary, LevelSummary, ModelSummary, NaturalFrequencies, ReportData, SweepSummary,
 };
 use crate::study::{
-    self, ContactSpec, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec, OutputSpec, Placement,
-    ReductionMethod, Snapshot, Study,
+    self, ContactMethod, ContactSpec, ContactStiffness, DampingSpec, Excitation, JointStiffness, LawSpec, ModelSpec,
+    OutputSpec, Placement, ReductionMethod, Snapshot, Study,
 };
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -133,15 +137,182 @@ pub fn run_level<O: Observer + ?Sized>(
     LevelSweeper::new(study, model, excitation, outputs)?.run(level, observer)
 }
 
-/// What the force levels of a study share, set up once: the condensed balance's linear part
-/// (the receptance, from the model's modes), Hill's setup when stability is asked, the
-/// outputs. Each level sweeps with a balance of its own that shares the linear part
-/// ([`CondensedHbm::share_linear_part`]), so levels run in parallel on one sweeper.
+/// What the force levels of a study share, set up once: the balance's linear part (the
+/// receptance, from the model's modes), Hill's setup when stability is asked, the outputs.
+/// Each level sweeps with a balance of its own that shares the linear part
+/// ([`CondensedHbm::share_linear_part`], [`DlftHbm::share_linear_part`]), so levels run in
+/// parallel on one sweeper.
 pub struct LevelSweeper<'a> {
     study: &'a Study,
-    hbm: CondensedHbm<'a>,
+    hbm: Balance<'a>,
     hill: Option<Hill>,
     selectors: Vec<OutputSelector>,
+}
+
+/// The balance a study solves: the condensed balance of its elements
+/// (`contact_method = "penalty"`), or the DLFT balance of its rigid contacts (`"dlft"`). Both
+/// recover the outputs from the forces on their directions (core `post`), so a point of either
+/// is one [`PointRecord`].
+// One per level, moved once: the size difference of the variants costs nothing.
+#[allow(clippy::large_enum_variant)]
+enum Balance<'m> {
+    Penalty(CondensedHbm<'m>),
+    Dlft(DlftHbm),
+}
+
+impl<'m> Balance<'m> {
+    /// The balance of `study` on `model`; `omega` (rad/s) is where the DLFT penalty ε is taken
+    /// (the structure's dynamic stiffness there, core `DlftHbm::for_model`; the collocated
+    /// solution does not depend on it).
+    fn new(study: &Study, model: &'m NonlinearModel, excitation: &Excitation, omega: f64) -> Result<Self, HbmError> {
+        let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
+        Ok(match study.hbm.contact_method {
+            ContactMethod::Penalty => Balance::Penalty(CondensedHbm::new(model, &excitation.pattern, settings)?),
+            ContactMethod::Dlft => Balance::Dlft(DlftHbm::for_model(model, &excitation.pattern, settings, omega)?),
+        })
+    }
+
+    fn share_linear_part(&self) -> Self {
+        match self {
+            Balance::Penalty(h) => Balance::Penalty(h.share_linear_part()),
+            Balance::Dlft(d) => Balance::Dlft(d.share_linear_part()),
+        }
+    }
+
+    fn sweep_frequency<O>(
+        &mut self,
+        level: f64,
+        omega_start: f64,
+        omega_end: f64,
+        options: &Options,
+        observer: &mut O,
+    ) -> Result<Branch, SweepError>
+    where
+        O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 'm>> + for<'a> PointObserver<DlftFrequencySweep<'a>>,
+    {
+        match self {
+            Balance::Penalty(h) => sweep_frequency(h, level, omega_start, omega_end, options, observer),
+            Balance::Dlft(d) => dlft::sweep_frequency(d, level, omega_start, omega_end, options, observer),
+        }
+    }
+
+    fn sweep_level<O: Observer + ?Sized>(
+        &mut self,
+        omega: f64,
+        level_start: f64,
+        level_end: f64,
+        options: &Options,
+        observer: &mut O,
+    ) -> Result<Branch, SweepError> {
+        match self {
+            Balance::Penalty(h) => sweep_level(h, omega, level_start, level_end, options, observer),
+            Balance::Dlft(d) => dlft::sweep_level(d, omega, level_start, level_end, options, observer),
+        }
+    }
+
+    fn evaluate_point(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        level: f64,
+        selectors: &[OutputSelector],
+    ) -> Result<PointResult, HbmError> {
+        match self {
+            Balance::Penalty(h) => evaluate_point(h, x, omega, level, selectors),
+            Balance::Dlft(d) => evaluate_dlft_point(d, x, omega, level, selectors),
+        }
+    }
+
+    /// The balance continued in frequency at `level`, for the location of peaks.
+    fn frequency_problem(&mut self, level: f64) -> FrequencyProblem<'_, 'm> {
+        match self {
+            Balance::Penalty(hbm) => FrequencyProblem::Penalty(FrequencySweep { hbm, level }),
+            // The bracket scales x by its own three points, not by the problem's scales.
+            Balance::Dlft(dlft) => FrequencyProblem::Dlft(DlftFrequencySweep { dlft, level, unknowns_scale: None }),
+        }
+    }
+}
+
+/// A [`Balance`] continued in frequency: the core problem of its kind.
+enum FrequencyProblem<'a, 'm> {
+    Penalty(FrequencySweep<'a, 'm>),
+    Dlft(DlftFrequencySweep<'a>),
+}
+
+impl FrequencyProblem<'_, '_> {
+    fn level(&self) -> f64 {
+        match self {
+            FrequencyProblem::Penalty(p) => p.level,
+            FrequencyProblem::Dlft(p) => p.level,
+        }
+    }
+
+    /// |X₁| of `selector` at the solution `x`, Ω: for the penalty balance recovered alone from
+    /// the evaluation that solved the point (core `output_amplitude`), for DLFT from the
+    /// point's results.
+    fn peak_quantity(&mut self, x: &[f64], omega: f64, selector: &OutputSelector) -> Result<f64, HbmError> {
+        let level = self.level();
+        match self {
+            FrequencyProblem::Penalty(p) => {
+                let prepared = p.hbm.receptance().outputs(&[&selector.vector]);
+                output_amplitude(p.hbm, x, omega, level, &prepared, 1)
+            }
+            FrequencyProblem::Dlft(p) => {
+                let r = evaluate_dlft_point(p.dlft, x, omega, level, std::slice::from_ref(selector))?;
+                Ok(r.outputs[0].harmonic(1).0)
+            }
+        }
+    }
+}
+
+impl Problem for FrequencyProblem<'_, '_> {
+    fn dimension(&self) -> usize {
+        match self {
+            FrequencyProblem::Penalty(p) => p.dimension(),
+            FrequencyProblem::Dlft(p) => p.dimension(),
+        }
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        match self {
+            FrequencyProblem::Penalty(p) => p.evaluate(x, lambda, residual, jacobian),
+            FrequencyProblem::Dlft(p) => p.evaluate(x, lambda, residual, jacobian),
+        }
+    }
+
+    fn scales(&self) -> Scales {
+        match self {
+            FrequencyProblem::Penalty(p) => p.scales(),
+            FrequencyProblem::Dlft(p) => p.scales(),
+        }
+    }
+
+    fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
+        match self {
+            FrequencyProblem::Penalty(p) => p.factored(),
+            FrequencyProblem::Dlft(p) => p.factored(),
+        }
+    }
+
+    fn completes_jacobian(&self) -> bool {
+        match self {
+            FrequencyProblem::Penalty(p) => p.completes_jacobian(),
+            FrequencyProblem::Dlft(p) => p.completes_jacobian(),
+        }
+    }
+
+    fn complete_jacobian(&mut self, jacobian: (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
+        match self {
+            FrequencyProblem::Penalty(p) => p.complete_jacobian(jacobian),
+            FrequencyProblem::Dlft(p) => p.complete_jacobian(jacobian),
+        }
+    }
 }
 
 impl<'a> LevelSweeper<'a> {
@@ -151,15 +322,23 @@ impl<'a> LevelSweeper<'a> {
         excitation: &Excitation,
         outputs: &[OutputSpec],
     ) -> Result<Self, SweepError> {
-        let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
-        let hbm = CondensedHbm::new(model, &excitation.pattern, settings)?;
-        let hill = match study.hbm.stability {
-            true => {
+        // ε of a DLFT balance at the band's centre.
+        let centre = TWO_PI * 0.5 * (study.sweep.start_hz + study.sweep.end_hz);
+        let hbm = Balance::new(study, model, excitation, centre)?;
+        let hill = match (study.hbm.stability, &hbm) {
+            (true, Balance::Penalty(hbm)) => {
                 let omega_max = TWO_PI * study.sweep.start_hz.max(study.sweep.end_hz);
                 let settings = HillSettings::for_band(study.hbm.harmonics, omega_max);
                 Some(Hill::new(hbm.receptance(), settings).map_err(BranchStabilityError::from)?)
             }
-            false => None,
+            // Refused by the study's validation: Hill's method is written for the elements of
+            // the penalty balance.
+            (true, Balance::Dlft(_)) => {
+                return Err(SweepError::Hbm(HbmError::Model(stickslip_core::model::ModelError::Invalid(
+                    "stability is not available with rigid contacts (contact_method = \"dlft\")".into(),
+                ))))
+            }
+            (false, _) => None,
         };
         Ok(LevelSweeper { study, hbm, hill, selectors: selectors(outputs) })
     }
@@ -173,40 +352,37 @@ impl<'a> LevelSweeper<'a> {
             study,
             hill,
             selectors,
+            level,
             progress: observer,
             points: Vec::new(),
             stabilities: Vec::new(),
             error: None,
         };
-        let branch: Branch = sweep_frequency(
-            &mut hbm,
-            level,
-            TWO_PI * study.sweep.start_hz,
-            TWO_PI * study.sweep.end_hz,
-            &options,
-            &mut recorder,
-        )?;
+        let (start, end) = (TWO_PI * study.sweep.start_hz, TWO_PI * study.sweep.end_hz);
+        let branch: Branch = hbm.sweep_frequency(level, start, end, &options, &mut recorder)?;
         if let Some(error) = recorder.error {
             return Err(error);
         }
         let PointRecorder { points, stabilities, .. } = recorder;
         let peaks = locate_peaks(&mut hbm, &branch, level, selectors, &points);
-        let bifurcations = match hill {
-            Some(hill) => bifurcations(&mut hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
-                .into_iter()
-                .map(|b| -> Result<BifurcationRecord, SweepError> {
-                    let result = evaluate_point(&mut hbm, &b.x, b.omega, level, selectors)?;
-                    Ok(BifurcationRecord {
-                        level_n: level,
-                        kind: b.kind.name().to_string(),
-                        frequency_hz: b.omega / TWO_PI,
-                        amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
-                        exponent_im: b.exponent.im,
-                        located: b.located,
+        let bifurcations = match (hill, &mut hbm) {
+            (Some(hill), Balance::Penalty(hbm)) => {
+                bifurcations(hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
+                    .into_iter()
+                    .map(|b| -> Result<BifurcationRecord, SweepError> {
+                        let result = evaluate_point(hbm, &b.x, b.omega, level, selectors)?;
+                        Ok(BifurcationRecord {
+                            level_n: level,
+                            kind: b.kind.name().to_string(),
+                            frequency_hz: b.omega / TWO_PI,
+                            amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
+                            exponent_im: b.exponent.im,
+                            located: b.located,
+                        })
                     })
-                })
-                .collect::<Result<Vec<_>, _>>()?,
-            None => Vec::new(),
+                    .collect::<Result<Vec<_>, _>>()?
+            }
+            _ => Vec::new(),
         };
         let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
             format!(
@@ -226,13 +402,14 @@ impl<'a> LevelSweeper<'a> {
 }
 
 /// The record of each point of a level (and its stability, when asked) made as the
-/// continuation accepts it, from the evaluation that converged there (core
-/// [`point_result`], [`stability_at_last_evaluation`]): nothing is evaluated again after the
-/// branch. Progress goes on to the caller's observer.
+/// continuation accepts it. For the penalty balance from the evaluation that converged there
+/// (core [`point_result`], [`stability_at_last_evaluation`]): nothing is evaluated again after
+/// the branch. Progress goes on to the caller's observer.
 struct PointRecorder<'s, O: ?Sized> {
     study: &'s Study,
     hill: Option<&'s Hill>,
     selectors: &'s [OutputSelector],
+    level: f64,
     progress: &'s mut O,
     points: Vec<PointRecord>,
     stabilities: Vec<Stability>,
@@ -240,9 +417,14 @@ struct PointRecorder<'s, O: ?Sized> {
     error: Option<SweepError>,
 }
 
-impl<'a, 'm, O: Observer + ?Sized> PointObserver<FrequencySweep<'a, 'm>> for PointRecorder<'_, O> {
-    fn on_accepted(&mut self, accepted: &mut Accepted<'_, FrequencySweep<'a, 'm>>) {
-        let (x, omega) = (&accepted.point().x, accepted.point().lambda);
+impl<O: Observer + ?Sized> PointRecorder<'_, O> {
+    /// Record the accepted point from its results (made by `results`) and, with `stability`,
+    /// its Floquet exponents.
+    fn record<P: Problem + ?Sized>(
+        &mut self,
+        accepted: &mut Accepted<'_, P>,
+        results: impl FnOnce(&mut P, &[f64], f64) -> Result<(PointResult, Option<Stability>), SweepError>,
+    ) {
         self.progress.on_point(accepted.point(), accepted.fraction_done());
         if self.error.is_some() {
             return;
@@ -250,28 +432,43 @@ impl<'a, 'm, O: Observer + ?Sized> PointObserver<FrequencySweep<'a, 'm>> for Poi
         // The measure Newton's tolerance applies to: ‖R‖ relative to the residual scale.
         let residual = accepted.point().residual_norm / accepted.residual_scale();
         let (iterations, index) = (accepted.point().iterations, self.points.len());
-        let x = x.clone();
-        let hbm = &mut *accepted.problem().hbm;
-        let outcome = (|| -> Result<(), SweepError> {
-            let result = point_result(hbm, &x, self.selectors)?;
-            let time_data = self.study.output_options.time_data.keeps(index);
-            let mut point = record(&result, iterations, residual, time_data);
-            if let Some(hill) = self.hill {
-                let stability = stability_at_last_evaluation(hbm, hill, &x, omega)?;
-                let leading = stability.leading();
-                point.stability = Some(PointStability {
-                    stable: is_stable(&stability, omega),
-                    exponent_re: leading.re,
-                    exponent_im: leading.im,
-                });
-                self.stabilities.push(stability);
+        let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
+        match results(accepted.problem(), &x, omega) {
+            Ok((result, stability)) => {
+                let mut point = record(&result, iterations, residual, self.study.output_options.time_data.keeps(index));
+                if let Some(stability) = stability {
+                    let leading = stability.leading();
+                    point.stability = Some(PointStability {
+                        stable: is_stable(&stability, omega),
+                        exponent_re: leading.re,
+                        exponent_im: leading.im,
+                    });
+                    self.stabilities.push(stability);
+                }
+                self.points.push(point);
             }
-            self.points.push(point);
-            Ok(())
-        })();
-        if let Err(error) = outcome {
-            self.error = Some(error);
+            Err(error) => self.error = Some(error),
         }
+    }
+}
+
+impl<'a, 'm, O: Observer + ?Sized> PointObserver<FrequencySweep<'a, 'm>> for PointRecorder<'_, O> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, FrequencySweep<'a, 'm>>) {
+        let (hill, selectors) = (self.hill, self.selectors);
+        self.record(accepted, |problem, x, omega| {
+            let result = point_result(problem.hbm, x, selectors)?;
+            let stability = hill.map(|hill| stability_at_last_evaluation(problem.hbm, hill, x, omega)).transpose()?;
+            Ok((result, stability))
+        });
+    }
+}
+
+impl<'a, O: Observer + ?Sized> PointObserver<DlftFrequencySweep<'a>> for PointRecorder<'_, O> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, DlftFrequencySweep<'a>>) {
+        let (selectors, level) = (self.selectors, self.level);
+        self.record(accepted, |problem, x, omega| {
+            Ok((evaluate_dlft_point(problem.dlft, x, omega, level, selectors)?, None))
+        });
     }
 }
 
@@ -292,7 +489,7 @@ const BIFURCATION_TOLERANCE: f64 = 1e-10;
 /// around it (a structure's outputs mostly resonate together). At an end of the band, or if
 /// the location fails, the sampled point.
 fn locate_peaks(
-    hbm: &mut CondensedHbm<'_>,
+    hbm: &mut Balance<'_>,
     branch: &Branch,
     level: f64,
     selectors: &[OutputSelector],
@@ -320,14 +517,13 @@ fn locate_peaks(
             peaks.push(sampled);
             continue;
         }
-        let prepared = hbm.receptance().outputs(&[&selector.vector]);
-        let mut problem = FrequencySweep { hbm, level };
+        let mut problem = hbm.frequency_problem(level);
         let bracket = brackets.entry(i).or_insert_with(|| {
             Bracket::new(&mut problem, [&branch.points[i - 1], &branch.points[i], &branch.points[i + 1]]).ok()
         });
         let found = bracket.as_mut().map(|bracket| {
             bracket.maximise(&mut problem, PEAK_TOLERANCE, |p, x, omega| {
-                output_amplitude(p.hbm, x, omega, level, &prepared, 1).map_err(|e| ProblemError::new(e.to_string()))
+                p.peak_quantity(x, omega, selector).map_err(|e| ProblemError::new(e.to_string()))
             })
         });
         peaks.push(match found {
@@ -368,8 +564,8 @@ pub fn run_snapshot(
     outputs: &[OutputSpec],
     snapshot: &Snapshot,
 ) -> Result<SnapshotResult, SnapshotError> {
-    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
-    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
+    let omega = TWO_PI * snapshot.frequency_hz;
+    let mut hbm = Balance::new(study, model, excitation, omega).map_err(SweepError::from)?;
     let selectors = selectors(outputs);
     let point = solve_at(study, &mut hbm, &selectors, snapshot.frequency_hz, snapshot.level, true)?;
     let sides = study
@@ -393,7 +589,7 @@ pub fn run_snapshot(
 /// signals if `time_data`).
 fn solve_at(
     study: &Study,
-    hbm: &mut CondensedHbm<'_>,
+    hbm: &mut Balance<'_>,
     selectors: &[OutputSelector],
     frequency_hz: f64,
     level: f64,
@@ -403,7 +599,7 @@ fn solve_at(
     let start = 1e-3 * level;
     // Steps relative to the ramp (1 = the whole of it), as the band's steps are to the band.
     let options = Options { max_points: study.continuation.max_points.max(1000), ..continuation_options(study) };
-    let branch = sweep_level(hbm, omega, start, level, &options, &mut Silent)?;
+    let branch = hbm.sweep_level(omega, start, level, &options, &mut Silent)?;
     let p = match (&branch.termination, branch.points.last()) {
         (TerminationReason::ReachedEnd, Some(p)) => p,
         (t, last) => {
@@ -412,7 +608,7 @@ fn solve_at(
             return Err(SnapshotError::NotReached { frequency_hz, level, start, why });
         }
     };
-    let result = evaluate_point(hbm, &p.x, omega, level, selectors).map_err(SweepError::from)?;
+    let result = hbm.evaluate_point(&p.x, omega, level, selectors).map_err(SweepError::from)?;
     Ok(record(&result, p.iterations, p.residual_norm / branch.residual_scale, time_data))
 }
 
@@ -426,8 +622,9 @@ pub fn run_grid(
     outputs: &[OutputSpec],
     level: f64,
 ) -> Result<LevelResult, SnapshotError> {
-    let settings = CoreHbmSettings { harmonics: study.hbm.harmonics, samples: study.hbm.samples };
-    let mut hbm = CondensedHbm::new(model, &excitation.pattern, settings).map_err(SweepError::from)?;
+    // ε of a DLFT balance at the grid's centre.
+    let (low, high) = study.grid_hz.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &f| (l.min(f), h.max(f)));
+    let mut hbm = Balance::new(study, model, excitation, TWO_PI * 0.5 * (low + high)).map_err(SweepError::from)?;
     let selectors = selectors(outputs);
     let points = study
         .grid_hz
@@ -620,22 +817,23 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
                     format!("threshold {} N, velocity scale {} m/s", number(*threshold), number(*velocity_scale)),
                 ),
                 LawSpec::Cubic { k3 } => ("cubic spring", format!("k3 = {} N/m³", number(*k3))),
-                LawSpec::Contact(ContactSpec {
-                    tangential,
-                    preload,
-                    normal_stiffness,
-                    tangential_stiffness,
-                    friction,
-                    ..
-                }) => (
-                    if tangential.len() == 1 { "2-D point contact" } else { "3-D point contact" },
-                    format!(
-                        "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
-                        number(*preload),
-                        number(*normal_stiffness),
-                        number(*tangential_stiffness),
-                        number(*friction)
-                    ),
+                LawSpec::Contact(ContactSpec { tangential, preload, stiffness, friction, .. }) => (
+                    match (tangential.len(), stiffness) {
+                        (1, Some(_)) => "2-D point contact",
+                        (_, Some(_)) => "3-D point contact",
+                        (1, None) => "2-D rigid point contact (DLFT)",
+                        (_, None) => "3-D rigid point contact (DLFT)",
+                    },
+                    match stiffness {
+                        Some(ContactStiffness { normal, tangential }) => format!(
+                            "N0 = {} N, k_n = {} N/m, k_t = {} N/m, μ = {}",
+                            number(*preload),
+                            number(*normal),
+                            number(*tangential),
+                            number(*friction)
+                        ),
+                        None => format!("N0 = {} N, rigid, μ = {}", number(*preload), number(*friction)),
+                    },
                 ),
             };
             let describe = |p: &Placement| match p {

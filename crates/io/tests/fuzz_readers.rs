@@ -38,7 +38,7 @@ fn sparse_finite(m: &LabelledMatrix) -> bool {
 
 #[test]
 fn study_files() {
-    let paths: Vec<PathBuf> = ["jenkins-1dof", "jenkins-2dof", "blade-joint", "harmony"]
+    let paths: Vec<PathBuf> = ["jenkins-1dof", "jenkins-2dof", "blade-joint", "harmony", "rigid-contact"]
         .iter()
         .map(|e| repo().join("examples").join(e).join("study.toml"))
         .collect();

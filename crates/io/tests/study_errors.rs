@@ -232,3 +232,147 @@ fn stability_with_a_damping_matrix_names_the_key_and_what_hill_needs() {
     let ok = GOOD.to_string() + "\n[harmonic_balance]\nstability = true\n";
     assert!(Study::parse(&ok, "study.toml").unwrap().hbm.stability);
 }
+
+/// `GOOD` with its Jenkins joint replaced by a rigid 2-D contact of a (tangential) and b
+/// (normal) against the ground, solved by DLFT.
+fn dlft() -> String {
+    let contact =
+        "name = \"pad\"\nlaw = \"contact2d\"\ntangential = [[\"a\"]]\nnormal = [\"b\"]\nfriction = 0.3\npreload = 10.0";
+    let jenkins = "name = \"j1\"\nlaw = \"jenkins\"\nbetween = [\"a\", \"b\"]\nstiffness = 1.0e4\nreplaces_stiffness = true\nthreshold = 5.0";
+    assert_eq!(GOOD.matches(jenkins).count(), 1);
+    GOOD.replace(jenkins, contact) + "\n[harmonic_balance]\ncontact_method = \"dlft\"\n"
+}
+
+/// `study.toml:LINE:` of the first line of `text` that contains `needle`.
+fn at_line(text: &str, needle: &str) -> String {
+    let line = text.lines().position(|l| l.contains(needle)).expect("needle in text") + 1;
+    format!("study.toml:{line}:")
+}
+
+#[test]
+fn a_dlft_study_builds_rigid_contacts_sampled_at_2n_plus_1() {
+    let study = Study::parse(&dlft(), "study.toml").unwrap();
+    // Collocation by default (7 harmonics, 15 samples): the DLFT solution is then free of ε.
+    assert_eq!((study.hbm.harmonics, study.hbm.samples), (7, 15));
+    let (model, _, _) = study.build_model().unwrap();
+    assert!(model.elements.is_empty());
+    let contact = &model.rigid_contacts[0];
+    assert_eq!((contact.name.as_str(), contact.friction, contact.preload), ("pad", 0.3, 10.0));
+    assert_eq!(contact.directions, vec![vec![1.0, 0.0], vec![0.0, 1.0]]);
+    // 2N + 1 written out is accepted.
+    let text = dlft().replace("contact_method = \"dlft\"", "contact_method = \"dlft\"\nharmonics = 3\nsamples = 7");
+    assert_eq!(Study::parse(&text, "study.toml").unwrap().hbm.samples, 7);
+}
+
+#[test]
+fn dlft_with_another_law_names_the_joint_the_key_and_what_is_expected() {
+    // The Jenkins joint of GOOD next to the rigid contact.
+    let jenkins = "[[joint]]\nname = \"j1\"\nlaw = \"jenkins\"\nbetween = [\"a\", \"b\"]\nthreshold = 5.0\n\n";
+    let text = dlft().replace("[excitation]", &format!("{jenkins}[excitation]"));
+    let msg = parse_error(&text);
+    println!("{msg}");
+    assert!(msg.starts_with(&at_line(&text, "law = \"jenkins\"")), "{msg}");
+    assert!(
+        msg.contains("[[joint]] \"j1\": law \"jenkins\" cannot be mixed with rigid contacts")
+            && msg.contains("[harmonic_balance] contact_method = \"dlft\"")
+            && msg.contains("every [[joint]] must be law = \"contact2d\" or \"contact3d\""),
+        "{msg}"
+    );
+}
+
+#[test]
+fn dlft_contact_inputs_name_the_key_and_what_is_expected() {
+    let text = dlft();
+    let cases = [
+        ("preload = 10.0", "preload = 0.0", "[[joint]] \"pad\": preload must be > 0 N, got 0: the contact would be open at rest"),
+        ("preload = 10.0", "preload = -5.0", "[[joint]] \"pad\": preload must be > 0 N, got -5"),
+        ("friction = 0.3", "friction = 12.0", "[[joint]] \"pad\": friction must lie in [0, 10] (a coefficient, not a force), got 12"),
+        ("friction = 0.3", "friction = -0.1", "[[joint]] \"pad\": friction must lie in [0, 10] (a coefficient, not a force), got -0.1"),
+        (
+            "preload = 10.0",
+            "preload = 10.0\nnormal_stiffness = 1.0e9",
+            "[[joint]] \"pad\": `normal_stiffness` does not apply with [harmonic_balance] contact_method = \"dlft\": the contact is rigid",
+        ),
+        (
+            "preload = 10.0",
+            "preload = 10.0\ntangential_stiffness = 1.0e9",
+            "[[joint]] \"pad\": `tangential_stiffness` does not apply with [harmonic_balance] contact_method = \"dlft\"",
+        ),
+        (
+            "contact_method = \"dlft\"",
+            "contact_method = \"dlft\"\nsamples = 300",
+            "[harmonic_balance]: with contact_method = \"dlft\", samples must be 2 harmonics + 1 = 15 (the default), got 300",
+        ),
+        (
+            "contact_method = \"dlft\"",
+            "contact_method = \"dlft\"\nstability = true",
+            "[harmonic_balance]: stability = true is not available with contact_method = \"dlft\"",
+        ),
+        (
+            "contact_method = \"dlft\"",
+            "contact_method = \"rigid\"",
+            "[harmonic_balance]: contact_method must be \"penalty\" (contacts with stiffness, the default) or \"dlft\" (rigid contacts), got \"rigid\"",
+        ),
+    ];
+    for (from, to, expected) in cases {
+        assert_eq!(text.matches(from).count(), 1, "{from:?}");
+        let bad = text.replace(from, to);
+        let msg = parse_error(&bad);
+        // The error points at the offending key's line (the last line `to` writes).
+        let key = to.lines().last().unwrap();
+        assert!(msg.starts_with(&at_line(&bad, key)), "{msg}");
+        assert!(msg.contains(expected), "{msg}\nexpected: {expected}");
+    }
+    // A penalty contact (the default method) still needs its stiffnesses.
+    let penalty = text.replace("contact_method = \"dlft\"", "contact_method = \"penalty\"");
+    let msg = parse_error(&penalty);
+    assert!(msg.contains("[[joint]] \"pad\": law \"contact2d\" needs `normal_stiffness` N/m"), "{msg}");
+}
+
+#[test]
+fn dlft_without_contacts_or_with_a_nonlinear_mode_is_refused() {
+    // GOOD's Jenkins joint alone.
+    let text = GOOD.to_string() + "\n[harmonic_balance]\ncontact_method = \"dlft\"\n";
+    let msg = parse_error(&text);
+    assert!(msg.contains("law \"jenkins\" cannot be mixed with rigid contacts"), "{msg}");
+    // A contact patch (its contacts hold its parts through their stiffness).
+    let text = r#"[model]
+mesh = "plates.inp"
+
+[[load]]
+name = "shaker"
+dof = "477.3"
+
+[[patch]]
+name = "lap"
+between = ["A_CONTACT", "B_CONTACT"]
+law = "contact3d"
+friction = 0.3
+normal_stiffness_per_area = 1.0e12
+tangential_stiffness_per_area = 5.0e11
+pressure = 1.0e6
+
+[excitation]
+levels = [1.0]
+
+[sweep]
+start_hz = 26.0
+end_hz = 38.0
+
+[harmonic_balance]
+contact_method = "dlft"
+"#;
+    let msg = parse_error(text);
+    assert!(msg.starts_with(&at_line(text, "[[patch]]")), "{msg}");
+    assert!(msg.contains("[[patch]] \"lap\": patches are not solved with rigid contacts"), "{msg}");
+    // No joint at all.
+    let start = dlft().find("[[joint]]").unwrap();
+    let end = dlft().find("[excitation]").unwrap();
+    let text = format!("{}{}", &dlft()[..start], &dlft()[end..]);
+    let msg = parse_error(&text);
+    assert!(msg.starts_with(&at_line(&text, "contact_method")), "{msg}");
+    assert!(msg.contains("solves rigid point contacts only, and the study has none"), "{msg}");
+    let text = dlft() + "\n[nonlinear_mode]\nmode = 1\namplitude_start = 1e-6\namplitude_end = 1e-3\n";
+    let msg = parse_error(&text);
+    assert!(msg.contains("[nonlinear_mode]: not available with rigid contacts"), "{msg}");
+}

@@ -141,6 +141,7 @@ impl PyStudy {
         let study = &self.study;
         let solved = py.detach(|| {
             guarded(|| {
+                study.require_penalty_contacts("the time integration").map_err(study_error)?;
                 let (model, excitation, outputs) = study.build_model().map_err(study_error)?;
                 let mut o =
                     SteadyStateOptions::new(frequency_hz, excitation.pattern.iter().map(|p| p * level_n).collect());

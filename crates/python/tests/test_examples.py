@@ -26,6 +26,7 @@ EXAMPLES = [
     ("duffing", "study.toml"),
     ("lap-joint", "study.toml"),
     ("lap-joint", "study-jenkins.toml"),
+    ("rigid-contact", "study.toml"),
 ]
 
 

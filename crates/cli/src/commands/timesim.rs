@@ -124,6 +124,7 @@ pub enum Coordinates {
 
 pub fn main(args: Args) -> anyhow::Result<()> {
     let study = Study::load(&args.study)?;
+    study.require_penalty_contacts("the time integration")?;
     let (model, excitation, outputs) = study.build_model()?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let scheme = if args.alpha == 0.0 { Scheme::AverageAcceleration } else { Scheme::Hht { alpha: args.alpha } };

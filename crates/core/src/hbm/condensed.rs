@@ -108,6 +108,7 @@ impl<'m> CondensedHbm<'m> {
         if force.len() != n {
             return Err(HbmError::ForceLength { got: force.len(), expected: n });
         }
+        model.check_no_rigid_contacts("the condensed harmonic balance")?;
         if model.elements.is_empty() {
             return Err(HbmError::NoElements);
         }

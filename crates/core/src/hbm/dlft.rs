@@ -91,6 +91,8 @@
 //! ([`DlftFrequencySweep`], [`DlftLevelSweep`]); dense matrices of size (2N+1)q (contacts are
 //! few here: a patch of many nodes would want the structured solvers of the penalty balance).
 
+use std::sync::Arc;
+
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
 use faer::{c64, Accum, Mat, MatMut, Par};
@@ -99,24 +101,24 @@ use super::condensed::{HbmError, HbmSettings, Jacobians};
 use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
-use crate::continuation::{Problem, ProblemError, Scales};
+use super::sweep::{off_resonance_of, SweepError};
+use crate::continuation::{
+    continue_branch, Branch, Options, PointObserver, Problem, ProblemError, Scales, Silent, TerminationReason,
+};
 use crate::elements::{Contact, ElementError};
-use crate::model::{LinearModel, ModelError};
+use crate::model::{LinearModel, ModelError, NonlinearModel};
 
-/// A rigid point contact: its application vectors (tangential first, then the normal
-/// approach, as for [`Contact`]), friction coefficient and normal preload (N).
-#[derive(Clone, Debug)]
-pub struct RigidContact {
-    pub name: String,
-    pub directions: Vec<Vec<f64>>,
-    pub friction: f64,
-    pub preload: f64,
-}
+/// A rigid point contact, defined with the models that hold it.
+pub use crate::model::RigidContact;
 
 /// The DLFT balance of a linear model with rigid contacts under `λ_F F cos Ωt`.
 pub struct DlftHbm {
     plan: AftPlan,
-    receptance: Receptance,
+    /// The linear part, shared by the balances of one model and excitation
+    /// ([`Self::share_linear_part`]).
+    receptance: Arc<Receptance>,
+    contacts: Vec<RigidContact>,
+    force: Vec<f64>,
     q: usize,
     offsets: Vec<usize>,
     /// The correction law of each contact: [`Contact`] with `k_t = k_n = ε`.
@@ -161,6 +163,35 @@ impl DlftHbm {
         settings: HbmSettings,
         epsilon: f64,
     ) -> Result<Self, HbmError> {
+        let receptance = Arc::new(Self::receptance_of(linear, contacts, force)?);
+        Self::with_receptance(contacts, force, settings, epsilon, receptance)
+    }
+
+    /// The balance of a model of rigid contacts ([`NonlinearModel::with_rigid_contacts`]), which
+    /// must have no other element (DLFT imposes the contacts' constraints only), with the
+    /// default ε at `omega` (rad/s, [`DlftHbm::default_epsilon`]; collocated, the solution does
+    /// not depend on it).
+    pub fn for_model(
+        model: &NonlinearModel,
+        force: &[f64],
+        settings: HbmSettings,
+        omega: f64,
+    ) -> Result<Self, HbmError> {
+        if let Some(e) = model.elements.first() {
+            return Err(HbmError::Model(ModelError::Invalid(format!(
+                "the DLFT balance solves rigid contacts only, and the model has the element {:?} ({})",
+                e.name,
+                e.law.kind()
+            ))));
+        }
+        let contacts = &model.rigid_contacts;
+        let receptance = Arc::new(Self::receptance_of(&model.linear, contacts, force)?);
+        let epsilon = mean_dynamic_stiffness(&receptance, omega);
+        Self::with_receptance(contacts, force, settings, epsilon, receptance)
+    }
+
+    /// The receptance on the contacts' directions, after checking their number and lengths.
+    fn receptance_of(linear: &LinearModel, contacts: &[RigidContact], force: &[f64]) -> Result<Receptance, HbmError> {
         let n = linear.n_dofs();
         if force.len() != n {
             return Err(HbmError::ForceLength { got: force.len(), expected: n });
@@ -168,21 +199,14 @@ impl DlftHbm {
         if contacts.is_empty() {
             return Err(HbmError::NoElements);
         }
-        let invalid = |m: String| HbmError::Model(ModelError::Invalid(m));
-        if !(epsilon.is_finite() && epsilon > 0.0) {
-            return Err(invalid(format!("DLFT: epsilon must be a finite number > 0 (N/m), got {epsilon}")));
-        }
-        let mut laws = Vec::with_capacity(contacts.len());
-        let mut offsets = Vec::with_capacity(contacts.len());
-        let mut q = 0;
         for c in contacts {
-            let element_error = |e: ElementError| invalid(format!("contact {:?}: {e}", c.name));
-            let law = match c.directions.len() {
-                2 => Contact::new_2d(epsilon, epsilon, c.friction, c.preload),
-                3 => Contact::new_3d(epsilon, epsilon, c.friction, c.preload),
-                d => return Err(invalid(format!("contact {:?}: needs 2 or 3 application vectors, got {d}", c.name))),
+            if !matches!(c.directions.len(), 2 | 3) {
+                return Err(HbmError::Model(ModelError::Invalid(format!(
+                    "contact {:?}: needs 2 or 3 application vectors, got {}",
+                    c.name,
+                    c.directions.len()
+                ))));
             }
-            .map_err(element_error)?;
             for v in &c.directions {
                 if v.len() != n {
                     return Err(HbmError::Model(ModelError::WrongLength {
@@ -192,19 +216,56 @@ impl DlftHbm {
                     }));
                 }
             }
+        }
+        let directions: Vec<&[f64]> = contacts.iter().flat_map(|c| c.directions.iter().map(|v| v.as_slice())).collect();
+        Ok(Receptance::new(linear, &directions, force)?)
+    }
+
+    /// A balance of the same contacts, excitation, settings and ε that shares this one's linear
+    /// part (the receptance: the model's modes, the costly part of [`Self::new`]) and has state
+    /// of its own, as [`super::CondensedHbm::share_linear_part`]: it evaluates exactly as a
+    /// balance made by [`Self::new`].
+    pub fn share_linear_part(&self) -> Self {
+        let settings = HbmSettings { harmonics: self.plan.n_harmonics(), samples: self.plan.n_samples() };
+        Self::with_receptance(&self.contacts, &self.force, settings, self.epsilon, Arc::clone(&self.receptance))
+            .expect("the settings of a balance that was set up")
+    }
+
+    fn with_receptance(
+        contacts: &[RigidContact],
+        force: &[f64],
+        settings: HbmSettings,
+        epsilon: f64,
+        receptance: Arc<Receptance>,
+    ) -> Result<Self, HbmError> {
+        let invalid = |m: String| HbmError::Model(ModelError::Invalid(m));
+        if !(epsilon.is_finite() && epsilon > 0.0) {
+            return Err(invalid(format!("DLFT: epsilon must be a finite number > 0 (N/m), got {epsilon}")));
+        }
+        let mut laws = Vec::with_capacity(contacts.len());
+        let mut offsets = Vec::with_capacity(contacts.len());
+        let mut q = 0;
+        for c in contacts {
+            let element_error = |e: ElementError| invalid(format!("contact {:?}: {e}", c.name));
+            let law = if c.directions.len() == 2 {
+                Contact::new_2d(epsilon, epsilon, c.friction, c.preload)
+            } else {
+                Contact::new_3d(epsilon, epsilon, c.friction, c.preload)
+            }
+            .map_err(element_error)?;
             offsets.push(q);
             q += c.directions.len();
             laws.push(law);
         }
         let plan = AftPlan::new(settings.harmonics, settings.samples)?;
-        let directions: Vec<&[f64]> = contacts.iter().flat_map(|c| c.directions.iter().map(|v| v.as_slice())).collect();
-        let receptance = Receptance::new(linear, &directions, force)?;
         let nc = plan.n_coeffs();
         let dim = nc * q;
         let afts = laws.iter().map(|l| ElementAft::new(l, &plan)).collect();
         let dims: Vec<usize> = contacts.iter().map(|c| c.directions.len() * nc).collect();
         Ok(DlftHbm {
             receptance,
+            contacts: contacts.to_vec(),
+            force: force.to_vec(),
             q,
             offsets,
             laws,
@@ -240,13 +301,7 @@ impl DlftHbm {
         force: &[f64],
         omega: f64,
     ) -> Result<f64, HbmError> {
-        let directions: Vec<&[f64]> = contacts.iter().flat_map(|c| c.directions.iter().map(|v| v.as_slice())).collect();
-        let receptance = Receptance::new(linear, &directions, force)?;
-        let q = directions.len();
-        let mut h = HarmonicReceptance::new(q);
-        receptance.evaluate_matrix(omega, &mut h);
-        let z = h.h.partial_piv_lu().inverse();
-        Ok((0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64)
+        Ok(mean_dynamic_stiffness(&Self::receptance_of(linear, contacts, force)?, omega))
     }
 
     /// `‖u_F(Ω)‖`: the contact directions' response to the force at unit level with the
@@ -260,6 +315,41 @@ impl DlftHbm {
     /// Number of unknowns (2N+1)q.
     pub fn dimension(&self) -> usize {
         self.q * self.plan.n_coeffs()
+    }
+
+    /// Number of contact directions q.
+    pub fn n_directions(&self) -> usize {
+        self.q
+    }
+
+    pub fn plan(&self) -> &AftPlan {
+        &self.plan
+    }
+
+    /// The linear part: the receptance on the contact directions, which also recovers any
+    /// output from the contact forces (Eq. 27, as for the condensed balance).
+    pub fn receptance(&self) -> &Receptance {
+        &self.receptance
+    }
+
+    /// The excitation pattern (N per unit level).
+    pub fn force(&self) -> &[f64] {
+        &self.force
+    }
+
+    pub fn contacts(&self) -> &[RigidContact] {
+        &self.contacts
+    }
+
+    /// The DLFT penalty ε (N/m).
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+
+    /// The stuck solution: a rigid contact that sticks and stays closed has no relative
+    /// motion, `x = 0` (exact while no sample slips or opens).
+    pub fn stuck_solution(&self) -> Vec<f64> {
+        vec![0.0; self.dimension()]
     }
 
     /// The contact forces `λ(x)` (harmonics, coefficient-major) of the last evaluation.
@@ -490,6 +580,10 @@ impl DlftHbm {
 pub struct DlftFrequencySweep<'a> {
     pub dlft: &'a mut DlftHbm,
     pub level: f64,
+    /// A typical `‖x‖` for the continuation's scaling ([`Scales::unknowns`]); `None`: from the
+    /// start point and the first tangent, which size nothing for a start that sticks (`x = 0`
+    /// and a zero tangent): [`sweep_frequency`] gives the free response there.
+    pub unknowns_scale: Option<f64>,
 }
 
 /// Continuation in force level of the DLFT balance at a fixed frequency (`λ` is λ_F).
@@ -512,6 +606,10 @@ impl Problem for DlftFrequencySweep<'_> {
     ) -> Result<(), ProblemError> {
         let jac = jacobian.map(|(dx, dl)| Jacobians { dx, domega: Some(dl), dlevel: None });
         self.dlft.evaluate(x, omega, self.level, residual, jac).map_err(problem_error)
+    }
+
+    fn scales(&self) -> Scales {
+        Scales { unknowns: self.unknowns_scale, residual: None }
     }
 }
 
@@ -539,6 +637,57 @@ impl Problem for DlftLevelSweep<'_> {
     }
 }
 
+/// Continue the DLFT balance at force level `level` from `omega_start` to `omega_end` (rad/s,
+/// either direction) from the stuck solution, as [`super::sweep_frequency`] does for the
+/// penalty balance: a start moved off an undamped resonance ([`off_resonance_of`]), and when
+/// Newton cannot reach the first point from `x = 0`, the start found by continuation in the
+/// force level from a thousandth of `level`. The continuation's scale of `x` is the contacts'
+/// free response `level ‖u_F(Ω_start)‖` (the relative motion with the contacts removed), since
+/// a stuck start has `x = 0`.
+pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>>(
+    dlft: &mut DlftHbm,
+    level: f64,
+    omega_start: f64,
+    omega_end: f64,
+    options: &Options,
+    observer: &mut O,
+) -> Result<Branch, SweepError> {
+    let omega_start =
+        off_resonance_of(&mut DlftFrequencySweep { dlft, level, unknowns_scale: None }, omega_start, omega_end);
+    let free = level * dlft.free_response_norm(omega_start);
+    let unknowns_scale = (free.is_finite() && free > 0.0).then_some(free);
+    let guess = dlft.stuck_solution();
+    let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
+    let branch = continue_branch(&mut problem, &guess, omega_start, omega_end, options, observer)?;
+    if !matches!(branch.termination, TerminationReason::FirstPointFailed { .. }) {
+        return Ok(branch);
+    }
+    let ramp = Options { max_points: options.max_points.max(1000), ..options.clone() };
+    let start = sweep_level(dlft, omega_start, 1e-3 * level, level, &ramp, &mut Silent)?;
+    match (&start.termination, start.points.last()) {
+        (TerminationReason::ReachedEnd, Some(p)) => {
+            let guess = p.x.clone();
+            let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
+            Ok(continue_branch(&mut problem, &guess, omega_start, omega_end, options, observer)?)
+        }
+        _ => Ok(branch),
+    }
+}
+
+/// Continue the DLFT balance at frequency `omega` (rad/s) in the force level from
+/// `level_start` to `level_end`, from the stuck solution `x = 0`.
+pub fn sweep_level<O: ?Sized + for<'a> PointObserver<DlftLevelSweep<'a>>>(
+    dlft: &mut DlftHbm,
+    omega: f64,
+    level_start: f64,
+    level_end: f64,
+    options: &Options,
+    observer: &mut O,
+) -> Result<Branch, SweepError> {
+    let guess = dlft.stuck_solution();
+    Ok(continue_branch(&mut DlftLevelSweep { dlft, omega }, &guess, level_start, level_end, options, observer)?)
+}
+
 /// A correction law without a periodic regime for a wild trial motion rejects the step (it is
 /// retried shorter), as in [`super::sweep`]; any other error ends the branch.
 fn problem_error(e: HbmError) -> ProblemError {
@@ -546,6 +695,15 @@ fn problem_error(e: HbmError) -> ProblemError {
         HbmError::Aft(_) => ProblemError::at_trial_iterate(e.to_string()),
         _ => ProblemError::new(e.to_string()),
     }
+}
+
+/// The mean of `|Z_ii(Ω)|` at harmonic 1, `Z = H⁻¹` the condensed dynamic stiffness.
+fn mean_dynamic_stiffness(receptance: &Receptance, omega: f64) -> f64 {
+    let q = receptance.n_directions();
+    let mut h = HarmonicReceptance::new(q);
+    receptance.evaluate_matrix(omega, &mut h);
+    let z = h.h.partial_piv_lu().inverse();
+    (0..q).map(|i| z[(i, i)].norm()).sum::<f64>() / q as f64
 }
 
 fn dot(row: faer::RowRef<'_, f64>, v: &[f64]) -> f64 {

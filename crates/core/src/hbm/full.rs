@@ -34,6 +34,7 @@ impl<'m> FullHbm<'m> {
         if force.len() != n {
             return Err(HbmError::ForceLength { got: force.len(), expected: n });
         }
+        model.check_no_rigid_contacts("the full harmonic balance")?;
         let plan = AftPlan::new(settings.harmonics, settings.samples)?;
         let modes = if model.linear.damping.is_modal() { Some(model.linear.dense_modes()?) } else { None };
         let damping = model.linear.damping_dense(modes.as_ref());

@@ -272,6 +272,7 @@ impl<'m> NonlinearMode<'m> {
     /// Set up the balance of mode `settings.mode` (0-based) of `model`. The model needs at least
     /// one element (see [`nonlinear_mode`] for a model without) and modal damping.
     pub fn new(model: &'m NonlinearModel, settings: &NonlinearModeSettings) -> Result<Self, NonlinearModeError> {
+        model.check_no_rigid_contacts("the nonlinear mode")?;
         if !model.linear.damping.is_modal() {
             return Err(NonlinearModeError::GeneralDamping);
         }
@@ -746,6 +747,7 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
     if !(valid(amplitude_start) && valid(amplitude_end) && amplitude_start < amplitude_end) {
         return Err(NonlinearModeError::InvalidAmplitudes { start: amplitude_start, end: amplitude_end });
     }
+    model.check_no_rigid_contacts("the nonlinear mode")?;
     if model.elements.is_empty() {
         return linear_backbone(model, settings, amplitude_start, amplitude_end, outputs);
     }

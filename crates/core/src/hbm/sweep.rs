@@ -191,15 +191,25 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
 pub fn off_resonance(hbm: &mut CondensedHbm<'_>, omega: f64, omega_toward: f64, level: f64) -> Result<f64, HbmError> {
     let n = hbm.dimension();
     let (zero, mut r) = (vec![0.0; n], vec![0.0; n]);
+    // An evaluation error is the balance's, not the frequency's: reported as such.
+    hbm.evaluate(&zero, omega, level, &mut r, None)?;
+    Ok(off_resonance_of(&mut FrequencySweep { hbm, level }, omega, omega_toward))
+}
+
+/// [`off_resonance`] for any balance continued in frequency (λ = Ω): the first of `omega` and
+/// the frequencies 1e-6, 1e-5, 1e-4 of it towards `omega_toward` where the residual at `x = 0`
+/// can be evaluated and is finite; `omega` if none is.
+pub fn off_resonance_of<P: Problem>(problem: &mut P, omega: f64, omega_toward: f64) -> f64 {
+    let n = problem.dimension();
+    let (zero, mut r) = (vec![0.0; n], vec![0.0; n]);
     let direction = if omega_toward >= omega { 1.0 } else { -1.0 };
     for shift in [0.0, 1e-6, 1e-5, 1e-4] {
         let w = omega * (1.0 + direction * shift);
-        hbm.evaluate(&zero, w, level, &mut r, None)?;
-        if r.iter().all(|v| v.is_finite()) {
-            return Ok(w);
+        if problem.evaluate(&zero, w, &mut r, None).is_ok() && r.iter().all(|v| v.is_finite()) {
+            return w;
         }
     }
-    Ok(omega)
+    omega
 }
 
 /// Continue the periodic response at frequency `omega` (rad/s) in the force level from

@@ -13,4 +13,4 @@ pub use dof::DofLabel;
 pub use linear::{LinearModel, ModelError, NamedVector};
 pub use matrix::Matrix;
 pub use modes::{symmetric_eigen, Modes};
-pub use nonlinear::{relative_direction, stiffness_along, ElementSite, NonlinearModel};
+pub use nonlinear::{relative_direction, stiffness_along, ElementSite, NonlinearModel, RigidContact};

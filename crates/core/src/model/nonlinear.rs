@@ -20,12 +20,27 @@ impl ElementSite {
     }
 }
 
+/// A rigid point contact (unilateral, Coulomb friction, no stiffness): its application vectors
+/// (tangential first, then the normal approach, as for [`crate::elements::Contact`]), friction
+/// coefficient and normal preload (N). Only the DLFT balance ([`crate::hbm::dlft`]) imposes
+/// it; the penalty balances and the time integrator refuse a model that has one.
+#[derive(Clone, Debug)]
+pub struct RigidContact {
+    pub name: String,
+    pub directions: Vec<Vec<f64>>,
+    pub friction: f64,
+    pub preload: f64,
+}
+
 /// The linear model and its local nonlinear elements: Eq. 12 without the excitation,
-/// `M Ü + D U̇ + K U + Σ_e V_e g_e = F`.
+/// `M Ü + D U̇ + K U + Σ_e V_e g_e = F`; or the linear model and rigid contacts, whose forces
+/// are constraint reactions rather than functions of the motion.
 #[derive(Debug)]
 pub struct NonlinearModel {
     pub linear: LinearModel,
     pub elements: Vec<ElementSite>,
+    /// Rigid contacts ([`NonlinearModel::with_rigid_contacts`]); empty for a model of elements.
+    pub rigid_contacts: Vec<RigidContact>,
 }
 
 impl NonlinearModel {
@@ -56,7 +71,59 @@ impl NonlinearModel {
                 }
             }
         }
-        Ok(NonlinearModel { linear, elements })
+        Ok(NonlinearModel { linear, elements, rigid_contacts: Vec::new() })
+    }
+
+    /// The linear model with rigid contacts and no element (what the DLFT balance solves).
+    /// Each contact needs 2 or 3 application vectors of the model's length, none zero, a
+    /// friction coefficient in `[0, MAX_FRICTION_COEFFICIENT]` and a preload > 0 N.
+    pub fn with_rigid_contacts(linear: LinearModel, contacts: Vec<RigidContact>) -> Result<Self, ModelError> {
+        let n = linear.n_dofs();
+        let max = crate::elements::MAX_FRICTION_COEFFICIENT;
+        for c in &contacts {
+            let invalid = |m: String| Err(ModelError::Invalid(format!("rigid contact {:?}: {m}", c.name)));
+            if !matches!(c.directions.len(), 2 | 3) {
+                return invalid(format!(
+                    "needs 2 or 3 application vectors (tangential, then normal), got {}",
+                    c.directions.len()
+                ));
+            }
+            if !(c.friction.is_finite() && (0.0..=max).contains(&c.friction)) {
+                return invalid(format!("friction coefficient must lie in [0, {max}], got {}", c.friction));
+            }
+            if !(c.preload.is_finite() && c.preload > 0.0) {
+                return invalid(format!(
+                    "normal preload must be a finite number > 0 (the contact is open at rest otherwise), got {}",
+                    c.preload
+                ));
+            }
+            for v in &c.directions {
+                if v.len() != n {
+                    return Err(ModelError::WrongLength {
+                        what: format!("application vector of rigid contact {:?}", c.name),
+                        len: v.len(),
+                        expected: n,
+                    });
+                }
+                if v.iter().all(|x| *x == 0.0) {
+                    return invalid("an application vector is zero".into());
+                }
+            }
+        }
+        Ok(NonlinearModel { linear, elements: Vec::new(), rigid_contacts: contacts })
+    }
+
+    /// An error unless the model is free of rigid contacts: `solver` (a penalty balance, the
+    /// time integrator) computes element forces from the motion, which a rigid contact has
+    /// not.
+    pub fn check_no_rigid_contacts(&self, solver: &str) -> Result<(), ModelError> {
+        match self.rigid_contacts.first() {
+            None => Ok(()),
+            Some(c) => Err(ModelError::Invalid(format!(
+                "{solver} cannot solve rigid contacts (contact {:?}): they are solved by the DLFT balance only",
+                c.name
+            ))),
+        }
     }
 
     /// Total number of application directions `q` (columns of `V`).

@@ -5,8 +5,9 @@
 use faer::c64;
 
 use crate::hbm::condensed::{complex_amplitude, CondensedHbm, HbmError};
-use crate::hbm::fourier::{amplitude_phase, cos_index, sin_index};
-use crate::hbm::receptance::Outputs;
+use crate::hbm::dlft::DlftHbm;
+use crate::hbm::fourier::{amplitude_phase, cos_index, sin_index, AftPlan};
+use crate::hbm::receptance::{Outputs, Receptance};
 
 /// A quantity to report: a name and the vector `o` such that the reported motion is `oᵀ U`
 /// (a unit vector for a DOF).
@@ -91,8 +92,8 @@ impl PointResult {
     }
 }
 
-/// Post-process a converged solution `x` of `hbm` at (Ω, λ_F): evaluate the balance there,
-/// then [`point_result`].
+/// Post-process a converged solution `x` of `hbm` at (Ω, λ_F): evaluate the balance there
+/// (unless it was last evaluated there), then [`point_result`].
 pub fn evaluate_point(
     hbm: &mut CondensedHbm<'_>,
     x: &[f64],
@@ -133,28 +134,128 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
     let Some((omega, level)) = hbm.last_evaluation().filter(|&(w, l)| hbm.evaluated_at(x, w, l)) else {
         return Err(HbmError::NotEvaluated);
     };
-    let q = hbm.n_directions();
-    let plan = hbm.plan();
+    let nt = hbm.plan().n_samples();
+    let mut offset = 0;
+    let mut elements = Vec::with_capacity(hbm.model().elements.len());
+    for (e, site) in hbm.model().elements.iter().enumerate() {
+        let d = site.law.n_dirs();
+        let aft = hbm.element_aft(e);
+        let law = site.law.as_ref();
+        // The joint's own force: f = g + K_r u (Eq. 11).
+        let force = (0..d * nt)
+            .map(|i| {
+                let (a, j) = (i / nt, i % nt);
+                aft.g[i] + (0..d).map(|b| law.replaced_stiffness(a, b) * aft.u[b * nt + j]).sum::<f64>()
+            })
+            .collect();
+        elements.push(ElementSamples {
+            name: &site.name,
+            offset,
+            dirs: d,
+            displacement: aft.u.clone(),
+            force,
+            slipping: &aft.slipping,
+        });
+        offset += d;
+    }
+    let linear = Linear { receptance: hbm.receptance(), force: hbm.force(), plan: hbm.plan(), q: hbm.n_directions() };
+    Ok(recovered_result(&linear, x, hbm.element_force_harmonics(), omega, level, outputs, elements))
+}
+
+/// Post-process a converged solution `x` of the DLFT balance at (Ω, λ_F) as
+/// [`evaluate_point`] does a penalty balance's: outputs recovered from the contact forces `λ`
+/// (Eq. 27, `U = Z⁻¹(λ_F F − V λ)`), and per contact the relative displacement `x` over the
+/// period (synthesised from its harmonics: the correction law's own samples are `y = λ_u/ε`),
+/// the contact force variations `(T, N − N0)` at the samples (the corrected forces), the
+/// stick fraction (samples where the correction's slider does not move: closed and stuck) and
+/// the slider velocity.
+pub fn evaluate_dlft_point(
+    dlft: &mut DlftHbm,
+    x: &[f64],
+    omega: f64,
+    level: f64,
+    outputs: &[OutputSelector],
+) -> Result<PointResult, HbmError> {
+    let mut residual = vec![0.0; dlft.dimension()];
+    dlft.evaluate(x, omega, level, &mut residual, None)?;
+    let (q, plan) = (dlft.n_directions(), dlft.plan());
+    let (nc, nt) = (plan.n_coeffs(), plan.n_samples());
+    let mut scratch = plan.scratch();
+    let mut offset = 0;
+    let mut elements = Vec::with_capacity(dlft.contacts().len());
+    for (e, contact) in dlft.contacts().iter().enumerate() {
+        let d = contact.directions.len();
+        let mut displacement = vec![0.0; d * nt];
+        for a in 0..d {
+            let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
+            plan.synthesize(&coeffs, &mut displacement[a * nt..(a + 1) * nt], &mut scratch);
+        }
+        let aft = dlft.contact_aft(e);
+        elements.push(ElementSamples {
+            name: &contact.name,
+            offset,
+            dirs: d,
+            displacement,
+            force: aft.g.clone(),
+            slipping: &aft.slipping,
+        });
+        offset += d;
+    }
+    let linear = Linear { receptance: dlft.receptance(), force: dlft.force(), plan, q };
+    Ok(recovered_result(&linear, x, dlft.contact_forces(), omega, level, outputs, elements))
+}
+
+/// The linear part of a balance, which recovers outputs from the forces on its q directions.
+struct Linear<'a> {
+    receptance: &'a Receptance,
+    force: &'a [f64],
+    plan: &'a AftPlan,
+    q: usize,
+}
+
+/// One element (or rigid contact) after the evaluation at the point: its directions
+/// `offset..offset + dirs` among the q, its displacement and force samples (`[a * nt + j]`)
+/// and whether it slips at each sample.
+struct ElementSamples<'a> {
+    name: &'a str,
+    offset: usize,
+    dirs: usize,
+    displacement: Vec<f64>,
+    force: Vec<f64>,
+    slipping: &'a [bool],
+}
+
+/// The results at a point of relative displacement harmonics `x` and force harmonics `g` on
+/// the q directions (coefficient-major), whatever balance found them: outputs and the
+/// excitation's work by recovery (Eq. 27), energies from the harmonics, loops from the samples.
+fn recovered_result(
+    linear: &Linear<'_>,
+    x: &[f64],
+    g: &[f64],
+    omega: f64,
+    level: f64,
+    outputs: &[OutputSelector],
+    elements: Vec<ElementSamples<'_>>,
+) -> PointResult {
+    let (q, plan, receptance) = (linear.q, linear.plan, linear.receptance);
     let (nh, nc, nt) = (plan.n_harmonics(), plan.n_coeffs(), plan.n_samples());
-    let g = hbm.element_force_harmonics().to_vec();
     let pi = std::f64::consts::PI;
 
     // Outputs and the excitation pattern, recovered harmonic by harmonic (Eq. 27).
-    let force = hbm.force().to_vec();
     let mut selectors: Vec<&[f64]> = outputs.iter().map(|o| o.vector.as_slice()).collect();
-    selectors.push(&force);
-    let prepared = hbm.receptance().outputs(&selectors);
+    selectors.push(linear.force);
+    let prepared = receptance.outputs(&selectors);
     let mut coeffs = vec![vec![0.0; nc]; selectors.len()];
     let mut viscous = 0.0;
     let g0: Vec<c64> = (0..q).map(|i| c64::new(g[i], 0.0)).collect();
-    let (mean, _) = hbm.receptance().recover(0.0, 0.0, &g0, &prepared);
+    let (mean, _) = receptance.recover(0.0, 0.0, &g0, &prepared);
     for (c, m) in coeffs.iter_mut().zip(&mean) {
         c[0] = m.re;
     }
     for k in 1..=nh {
-        let gk: Vec<c64> = (0..q).map(|i| complex_amplitude(&g, q, k, i)).collect();
+        let gk: Vec<c64> = (0..q).map(|i| complex_amplitude(g, q, k, i)).collect();
         let lk = if k == 1 { level } else { 0.0 };
-        let (amps, udu) = hbm.receptance().recover(k as f64 * omega, lk, &gk, &prepared);
+        let (amps, udu) = receptance.recover(k as f64 * omega, lk, &gk, &prepared);
         // ∫₀ᵀ U̇ᵀ D U̇ dt = π Ω Σ_k k² Uᴴ D U.
         viscous += pi * omega * (k * k) as f64 * udu;
         for (c, a) in coeffs.iter_mut().zip(&amps) {
@@ -177,10 +278,9 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
         output_results.push(OutputResult { name: o.name.clone(), coeffs: c.clone(), displacement, velocity, peak });
     }
 
-    let mut element_results = Vec::new();
-    let mut offset = 0;
-    for (e, site) in hbm.model().elements.iter().enumerate() {
-        let d = site.law.n_dirs();
+    let mut element_results = Vec::with_capacity(elements.len());
+    for e in elements {
+        let (offset, d) = (e.offset, e.dirs);
         // ∮ g du = π Σ_k k (s_k g_ck − c_k g_sk), exact for the truncated motion.
         let direction_energy: Vec<f64> = (offset..offset + d)
             .map(|a| {
@@ -192,20 +292,8 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
                     .sum()
             })
             .collect();
-        let aft = hbm.element_aft(e);
-        let law = site.law.as_ref();
-        let series = |a: usize| &aft.u[a * nt..(a + 1) * nt];
-        let displacement: Vec<Vec<f64>> = (0..d).map(|a| series(a).to_vec()).collect();
-        let force = (0..d)
-            .map(|a| {
-                (0..nt)
-                    .map(|j| {
-                        aft.g[a * nt + j]
-                            + (0..d).map(|b| law.replaced_stiffness(a, b) * aft.u[b * nt + j]).sum::<f64>()
-                    })
-                    .collect()
-            })
-            .collect();
+        let displacement: Vec<Vec<f64>> = e.displacement.chunks(nt).map(<[f64]>::to_vec).collect();
+        let force: Vec<Vec<f64>> = e.force.chunks(nt).map(<[f64]>::to_vec).collect();
         // The velocity samples as the AFT computes them, Ω du/dθ (it skips them for the
         // rate-independent laws, whose update never reads them).
         let mut rate = vec![0.0; nt];
@@ -213,12 +301,12 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
             .map(|a| {
                 let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
                 plan.synthesize_derivative(&coeffs, &mut rate, &mut scratch);
-                (0..nt).map(|j| if aft.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
+                (0..nt).map(|j| if e.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
             })
             .collect();
-        let stuck = aft.slipping.iter().filter(|s| !**s).count();
+        let stuck = e.slipping.iter().filter(|s| !**s).count();
         element_results.push(ElementResult {
-            name: site.name.clone(),
+            name: e.name.to_string(),
             energy_per_cycle: direction_energy.iter().sum(),
             direction_energy,
             stick_fraction: stuck as f64 / nt as f64,
@@ -226,14 +314,13 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
             force,
             slider_velocity,
         });
-        offset += d;
     }
-    Ok(PointResult {
+    PointResult {
         omega,
         level,
         outputs: output_results,
         elements: element_results,
         excitation_work,
         viscous_dissipation: viscous,
-    })
+    }
 }

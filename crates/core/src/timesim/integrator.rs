@@ -215,6 +215,7 @@ impl<'m> Integrator<'m> {
             return Err(TimesimError::InvalidStep(step));
         }
         let (alpha, beta, gamma) = scheme.parameters()?;
+        model.check_no_rigid_contacts("the time integrator")?;
         let lin = &model.linear;
         lin.check()?;
         let n = lin.n_dofs();

@@ -7,7 +7,7 @@ use faer::Side;
 use stickslip_core::elements::{Contact, CubicSpring, Element, Iwan, Jenkins, RegularizedCoulomb};
 use stickslip_core::model::{
     relative_direction, stiffness_along, Damping, DofLabel, ElementSite, LinearModel, Matrix, ModelError, NamedVector,
-    NonlinearModel,
+    NonlinearModel, RigidContact,
 };
 use stickslip_fe::assembly::FeModel;
 use stickslip_fe::eigen::EigenOptions;
@@ -253,13 +253,18 @@ impl Study {
         }
 
         let mut sites = Vec::with_capacity(self.joints.len());
+        let mut rigid = Vec::new();
         let mut replaced = Vec::new();
         for j in &self.joints {
-            let (site, replaced_k) = self.joint_site(&linear, &space, j).map_err(|k| err(j.at, k))?;
-            if let Some(k) = replaced_k {
-                replaced.push((j, k, site.directions[0].clone()));
+            match self.joint_site(&linear, &space, j).map_err(|k| err(j.at, k))? {
+                BuiltJoint::Element(site, replaced_k) => {
+                    if let Some(k) = replaced_k {
+                        replaced.push((j, k, site.directions[0].clone()));
+                    }
+                    sites.push(site);
+                }
+                BuiltJoint::Rigid(contact) => rigid.push(contact),
             }
-            sites.push(site);
         }
         check_slipped_stiffness(&linear, &replaced).map_err(|(at, m)| err(at, StudyErrorKind::Invalid(m)))?;
         for p in &base.patches {
@@ -299,7 +304,14 @@ impl Study {
             outs
         };
 
-        let model = NonlinearModel::new(linear, sites).map_err(|e| err(model_at.section, model_error(e)))?;
+        // Validation keeps rigid contacts (contact_method = "dlft") apart from every element.
+        let model = if rigid.is_empty() {
+            NonlinearModel::new(linear, sites)
+        } else {
+            debug_assert!(sites.is_empty(), "rigid contacts come without elements");
+            NonlinearModel::with_rigid_contacts(linear, rigid)
+        }
+        .map_err(|e| err(model_at.section, model_error(e)))?;
         Ok((model, excitation, outputs))
     }
 
@@ -560,14 +572,9 @@ impl Study {
         Ok(out)
     }
 
-    /// The element of one joint on its application vector, and the stiffness it replaces in K
-    /// (paper form, Eq. 11), if any.
-    fn joint_site(
-        &self,
-        linear: &LinearModel,
-        space: &DofSpace,
-        j: &JointSpec,
-    ) -> Result<(ElementSite, Option<f64>), StudyErrorKind> {
+    /// The element of one joint on its application vector and the stiffness it replaces in K
+    /// (paper form, Eq. 11), if any; or a rigid contact.
+    fn joint_site(&self, linear: &LinearModel, space: &DofSpace, j: &JointSpec) -> Result<BuiltJoint, StudyErrorKind> {
         let ctx = format!("[[joint]] {:?}", j.name);
         let mut v = vector(space, &j.placement, &ctx)?;
         normalise_user_vector(&mut v, &j.placement, &ctx)?;
@@ -608,30 +615,34 @@ impl Study {
                 Box::new(RegularizedCoulomb::new(*threshold, *velocity_scale).map_err(element_error)?)
             }
             LawSpec::Cubic { k3 } => Box::new(CubicSpring::new(*k3).map_err(element_error)?),
-            LawSpec::Contact(ContactSpec {
-                tangential,
-                normal,
-                preload,
-                normal_stiffness,
-                tangential_stiffness,
-                friction,
-            }) => {
+            LawSpec::Contact(ContactSpec { tangential, normal, preload, stiffness, friction }) => {
                 // Directions tangential first, then normal, as the element expects; a pair is
                 // U_a − U_b (no normalisation: the stiffnesses act on that difference).
                 let directions =
                     tangential.iter().chain([normal]).map(|p| vector(space, p, &ctx)).collect::<Result<Vec<_>, _>>()?;
-                let (kt, kn) = (*tangential_stiffness, *normal_stiffness);
+                let Some(ContactStiffness { normal: kn, tangential: kt }) = *stiffness else {
+                    let contact =
+                        RigidContact { name: j.name.clone(), directions, friction: *friction, preload: *preload };
+                    return Ok(BuiltJoint::Rigid(contact));
+                };
                 let law = if tangential.len() == 1 {
                     Contact::new_2d(kt, kn, *friction, *preload)
                 } else {
                     Contact::new_3d(kt, kn, *friction, *preload)
                 };
                 let law = Box::new(law.map_err(element_error)?);
-                return Ok((ElementSite { name: j.name.clone(), law, directions }, None));
+                return Ok(BuiltJoint::Element(ElementSite { name: j.name.clone(), law, directions }, None));
             }
         };
-        Ok((ElementSite { name: j.name.clone(), law, directions: vec![v] }, replaced))
+        Ok(BuiltJoint::Element(ElementSite { name: j.name.clone(), law, directions: vec![v] }, replaced))
     }
+}
+
+/// A joint built on the analysed model: an element of the penalty balance with the stiffness it
+/// replaces in K (if any), or a rigid contact of the DLFT balance.
+enum BuiltJoint {
+    Element(ElementSite, Option<f64>),
+    Rigid(RigidContact),
 }
 
 /// The contact elements of a patch, one per pair, named `patch-node` (the id of the pair's

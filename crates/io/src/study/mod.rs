@@ -218,16 +218,24 @@ pub enum LawSpec {
 }
 
 /// A point contact (`contact2d`: one tangential direction, `contact3d`: two), standalone: the
-/// joint adds its own stiffnesses. The joint's `placement` is its first tangential direction;
-/// `tangential` holds all of them, `normal` the normal approach.
+/// joint adds its own stiffnesses, or none when it is rigid. The joint's `placement` is its
+/// first tangential direction; `tangential` holds all of them, `normal` the normal approach.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSpec {
     pub tangential: Vec<Placement>,
     pub normal: Placement,
     pub preload: f64,
-    pub normal_stiffness: f64,
-    pub tangential_stiffness: f64,
+    /// The penalty stiffnesses; `None` for a rigid contact (`[harmonic_balance] contact_method
+    /// = "dlft"`).
+    pub stiffness: Option<ContactStiffness>,
     pub friction: f64,
+}
+
+/// The penalty stiffnesses of a point contact (N/m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactStiffness {
+    pub normal: f64,
+    pub tangential: f64,
 }
 
 /// A joint: a nonlinear element on an application vector.
@@ -310,12 +318,31 @@ pub struct HbmSettings {
     pub max_iterations: usize,
     /// Stability of every point by Hill's method, and the bifurcations (default false).
     pub stability: bool,
+    /// How contacts are solved (default: penalty elements).
+    pub contact_method: ContactMethod,
 }
 
 impl Default for HbmSettings {
     fn default() -> Self {
-        HbmSettings { harmonics: 7, samples: 300, tolerance: 1e-8, max_iterations: 20, stability: false }
+        HbmSettings {
+            harmonics: 7,
+            samples: 300,
+            tolerance: 1e-8,
+            max_iterations: 20,
+            stability: false,
+            contact_method: ContactMethod::Penalty,
+        }
     }
+}
+
+/// `[harmonic_balance] contact_method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactMethod {
+    /// Every joint is an element of the condensed balance; contacts have penalty stiffnesses.
+    Penalty,
+    /// Rigid contacts by the dynamic Lagrangian frequency-time method (core `hbm::dlft`): every
+    /// joint is a point contact without stiffness, sampled at `2N + 1` instants per period.
+    Dlft,
 }
 
 /// Predictor of the pseudo-arclength continuation.
@@ -501,6 +528,22 @@ impl Study {
     /// relative paths.
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Study, StudyError> {
         validate::parse(text, path.as_ref())
+    }
+
+    /// An error unless the study's contacts have stiffness: `what` (a time integration) needs
+    /// element forces that follow from the motion, which rigid contacts
+    /// (`contact_method = "dlft"`) have not.
+    pub fn require_penalty_contacts(&self, what: &str) -> Result<(), StudyError> {
+        match self.hbm.contact_method {
+            ContactMethod::Penalty => Ok(()),
+            ContactMethod::Dlft => Err(StudyError {
+                file: self.path.clone(),
+                location: None,
+                kind: Box::new(StudyErrorKind::Invalid(format!(
+                    "[harmonic_balance] contact_method = \"dlft\": {what} needs contacts with stiffness, and rigid contacts are solved by the harmonic balance only; for {what}, set contact_method = \"penalty\" and give each contact normal_stiffness and tangential_stiffness (N/m)"
+                ))),
+            }),
+        }
     }
 
     /// Validate a study given as a table (e.g. a Python dict) rather than as text: the table

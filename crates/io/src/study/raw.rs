@@ -186,6 +186,7 @@ pub(crate) struct RawHarmonicBalance {
     pub tolerance: Option<S<f64>>,
     pub max_iterations: Option<S<i64>>,
     pub stability: Option<S<bool>>,
+    pub contact_method: Option<S<String>>,
 }
 
 #[derive(Deserialize)]

@@ -106,9 +106,12 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
     }
     unique_names(&src, raw.load.iter().map(|l| &l.get_ref().name), "[[load]]")?;
 
+    // The harmonic balance first: its contact method decides what a contact joint takes.
+    let hbm = hbm(&src, raw.harmonic_balance.as_ref())?;
+    let rigid = hbm.contact_method == ContactMethod::Dlft;
     let mut joints = Vec::new();
     for j in &raw.joint {
-        joints.push(joint(&src, j)?);
+        joints.push(joint(&src, j, rigid)?);
     }
     unique_names(&src, raw.joint.iter().map(|j| &j.get_ref().name), "[[joint]]")?;
     let mesh_model = matches!(model, ModelSpec::Mesh { .. } | ModelSpec::Harmony { .. });
@@ -117,10 +120,12 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
         patches.push(patch(&src, p, mesh_model)?);
     }
     unique_names(&src, raw.patch.iter().map(|p| &p.get_ref().name), "[[patch]]")?;
+    if rigid {
+        dlft_scope(&src, &raw, &joints)?;
+    }
 
     let excitation = excitation(&src, &raw.excitation, &loads)?;
     let sweep = sweep(&src, &raw.sweep)?;
-    let hbm = hbm(&src, raw.harmonic_balance.as_ref())?;
     // Hill's method is written in the modes (docs/stability.md): a general damping matrix
     // cannot be used there.
     if let (true, DampingSpec::Matrix(_) | DampingSpec::File(_)) = (hbm.stability, &damping) {
@@ -828,14 +833,15 @@ fn contact_placement(
     Ok((tangential[0].clone(), span))
 }
 
-/// The contact law's parameters: stiffnesses > 0, friction coefficient in [0, 10], a preload
-/// that closes the contact at rest.
+/// The contact law's parameters: stiffnesses > 0 (none for a `rigid` contact), friction
+/// coefficient in [0, 10], a preload that closes the contact at rest.
 fn contact_law(
     src: &Source,
     r: &raw::RawJoint,
     whole: &Range<usize>,
     ctx: &str,
     law: &str,
+    rigid: bool,
 ) -> Result<LawSpec, StudyError> {
     let (tangential, normal, _) = contact_directions(src, r, whole, ctx)?;
     let need = |v: &Option<S<f64>>, key: &str, unit: &str| -> Result<f64, StudyError> {
@@ -865,17 +871,30 @@ fn contact_law(
             x
         }
     };
-    Ok(LawSpec::Contact(ContactSpec {
-        tangential,
-        normal,
-        preload,
-        normal_stiffness: need(&r.normal_stiffness, "normal_stiffness", " N/m")?,
-        tangential_stiffness: need(&r.tangential_stiffness, "tangential_stiffness", " N/m")?,
-        friction,
-    }))
+    let stiffness = if rigid {
+        // A stiffness given for a rigid contact would be silently unused: refused.
+        for (key, given) in
+            [("normal_stiffness", &r.normal_stiffness), ("tangential_stiffness", &r.tangential_stiffness)]
+        {
+            if let Some(v) = given {
+                return Err(src.invalid(
+                    &v.span(),
+                    format!("{ctx}: `{key}` does not apply with [harmonic_balance] contact_method = \"dlft\": the contact is rigid (no penetration, no elastic slip); remove it, or use contact_method = \"penalty\" for a contact with stiffness"),
+                ));
+            }
+        }
+        None
+    } else {
+        Some(ContactStiffness {
+            normal: need(&r.normal_stiffness, "normal_stiffness", " N/m")?,
+            tangential: need(&r.tangential_stiffness, "tangential_stiffness", " N/m")?,
+        })
+    };
+    Ok(LawSpec::Contact(ContactSpec { tangential, normal, preload, stiffness, friction }))
 }
 
-fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
+/// A `[[joint]]`; `rigid`: contacts are rigid (`contact_method = "dlft"`) and take no stiffness.
+fn joint(src: &Source, j: &S<raw::RawJoint>, rigid: bool) -> Result<JointSpec, StudyError> {
     let r = j.get_ref();
     check_name(src, &r.name, "[[joint]]")?;
     let ctx = format!("[[joint]] {:?}", r.name.get_ref());
@@ -957,7 +976,7 @@ fn joint(src: &Source, j: &S<raw::RawJoint>) -> Result<JointSpec, StudyError> {
             threshold: need(&r.threshold, "threshold", " N")?,
             velocity_scale: need(&r.velocity_scale, "velocity_scale", " m/s")?,
         },
-        "contact2d" | "contact3d" => contact_law(src, r, &j.span(), &ctx, law_name)?,
+        "contact2d" | "contact3d" => contact_law(src, r, &j.span(), &ctx, law_name, rigid)?,
         _ => LawSpec::Cubic {
             k3: match &r.k3 {
                 Some(k) => finite(src, k, &ctx, "k3")?,
@@ -1152,18 +1171,104 @@ fn sweep(src: &Source, s: &S<raw::RawSweep>) -> Result<SweepSettings, StudyError
     Ok(SweepSettings { start_hz, end_hz, step_hz })
 }
 
+/// What `contact_method = "dlft"` can solve: the DLFT balance (core `hbm::dlft`) imposes rigid
+/// point contacts on the linear model and has no other element, no stability analysis and no
+/// nonlinear mode; its patches would need the contacts' stiffness in K (a part held by a patch
+/// alone is free without it) and a static pre-step of rigid contacts. Each refusal names the
+/// key and what is expected.
+fn dlft_scope(src: &Source, raw: &RawStudy, joints: &[JointSpec]) -> Result<(), StudyError> {
+    const WHY: &str = "[harmonic_balance] contact_method = \"dlft\" solves rigid point contacts only";
+    let method_span = raw
+        .harmonic_balance
+        .as_ref()
+        .and_then(|h| h.get_ref().contact_method.as_ref())
+        .map(|m| m.span())
+        .unwrap_or(0..0);
+    for (j, raw_joint) in joints.iter().zip(&raw.joint) {
+        if !matches!(j.law, LawSpec::Contact(_)) {
+            let law = raw_joint.get_ref().law.get_ref();
+            return Err(src.invalid(
+                &raw_joint.get_ref().law.span(),
+                format!(
+                    "[[joint]] {:?}: law {law:?} cannot be mixed with rigid contacts ({WHY}): with it every [[joint]] must be law = \"contact2d\" or \"contact3d\"; for other laws use contact_method = \"penalty\" (the default) with penalty contacts",
+                    j.name
+                ),
+            ));
+        }
+    }
+    if let Some(p) = raw.patch.first() {
+        return Err(src.invalid(
+            &p.span(),
+            format!(
+                "[[patch]] {:?}: patches are not solved with rigid contacts ({WHY}, given as [[joint]] law = \"contact2d\"/\"contact3d\"): a patch's contacts hold its parts through their stiffness; use contact_method = \"penalty\" for patches",
+                p.get_ref().name.get_ref()
+            ),
+        ));
+    }
+    if joints.is_empty() {
+        return Err(src.invalid(
+            &method_span,
+            format!("{WHY}, and the study has none: add [[joint]] sections with law = \"contact2d\" or \"contact3d\""),
+        ));
+    }
+    if let Some(m) = &raw.nonlinear_mode {
+        return Err(src.invalid(
+            &m.span(),
+            format!("[nonlinear_mode]: not available with rigid contacts ({WHY}, by forced sweeps): remove [nonlinear_mode] or use contact_method = \"penalty\""),
+        ));
+    }
+    Ok(())
+}
+
 fn hbm(src: &Source, h: Option<&S<raw::RawHarmonicBalance>>) -> Result<HbmSettings, StudyError> {
     const CTX: &str = "[harmonic_balance]";
     let mut out = HbmSettings::default();
     let Some(h) = h else { return Ok(out) };
     let r = h.get_ref();
+    if let Some(m) = &r.contact_method {
+        out.contact_method = match m.get_ref().as_str() {
+            "penalty" => ContactMethod::Penalty,
+            "dlft" => ContactMethod::Dlft,
+            other => {
+                return Err(src.invalid(
+                    &m.span(),
+                    format!("{CTX}: contact_method must be \"penalty\" (contacts with stiffness, the default) or \"dlft\" (rigid contacts), got {other:?}"),
+                ))
+            }
+        };
+    }
     if let Some(n) = &r.harmonics {
         out.harmonics = count_at_most(src, n, CTX, "harmonics", 1, MAX_HARMONICS)?;
+    }
+    let collocated = 2 * out.harmonics + 1;
+    if out.contact_method == ContactMethod::Dlft {
+        // One sample per unknown coefficient: the DLFT constraints then hold exactly at the
+        // samples and the solution does not depend on the DLFT penalty ε (module docs of core
+        // `hbm::dlft`); with more samples it moves with ε by the truncation error, and ε is a
+        // numerical setting the study does not choose. Hence the default and the only value.
+        out.samples = collocated;
+        if let Some(s) = &r.samples {
+            if *s.get_ref() != collocated as i64 {
+                return Err(src.invalid(
+                    &s.span(),
+                    format!(
+                        "{CTX}: with contact_method = \"dlft\", samples must be 2 harmonics + 1 = {collocated} (the default), got {}: with one sample per unknown the rigid contact's constraints hold exactly at the samples and the result does not depend on the DLFT penalty; leave samples out",
+                        s.get_ref()
+                    ),
+                ));
+            }
+        }
+        if let Some(b) = r.stability.as_ref().filter(|b| *b.get_ref()) {
+            return Err(src.invalid(
+                &b.span(),
+                format!("{CTX}: stability = true is not available with contact_method = \"dlft\" (Hill's method is written for the penalty balance's elements); remove it"),
+            ));
+        }
     }
     if let Some(s) = &r.samples {
         out.samples = count_at_most(src, s, CTX, "samples", 1, MAX_SAMPLES)?;
     }
-    let min = 2 * out.harmonics + 1;
+    let min = collocated;
     if out.samples < min {
         let span = r.samples.as_ref().map(|s| s.span()).unwrap_or(h.span());
         return Err(src.invalid(
