@@ -565,7 +565,8 @@ fn variable_normal_load_matches_the_event_resolved_solution() {
 ///
 /// In phase (`φ = 0`, `δ₁ = δ₂ = 0`) with partial separation (`Q > P`): the backward slip ends
 /// where the contact opens, `F(θ_o) = 0`; open (`T = 0`) until `2π − θ_o`; then (`K > Q`) a
-/// forward slip from the re-contact. Each phase has `T = α + β cos θ + γ sin θ`, so the
+/// forward slip from the re-contact. In opposite phase (`φ = π`) with partial separation, see
+/// [`opposite_phase_with_separation`]. Each phase has `T = α + β cos θ + γ sin θ`, so the
 /// energy per cycle `W = ∮ T du_t` and the first harmonic of T are sums of elementary
 /// integrals. Returns `(W, c₁, s₁)`, `T₁ = c₁ cos θ + s₁ sin θ`.
 fn closed_form(a: f64, b: f64, phi: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> (f64, f64, f64) {
@@ -590,6 +591,8 @@ fn closed_form(a: f64, b: f64, phi: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> 
             (PI + d1, theta2, t_c + k * d1.cos(), k, 0.0),
             (theta2, 2.0 * PI - d2, p, qc, qs),
         ]
+    } else if phi == PI {
+        opposite_phase_with_separation(k, p, q)
     } else {
         assert!(phi == 0.0 && k > q && k > p, "partial separation: in phase, gross slip");
         let theta1 = ((k - 2.0 * p - q) / (k + q)).acos();
@@ -613,6 +616,51 @@ fn closed_form(a: f64, b: f64, phi: f64, kt: f64, kn: f64, mu: f64, n0: f64) -> 
         c1 += ic / PI;
     }
     (w, c1, s1)
+}
+
+/// Opposite phase (`φ = π`: the normal load falls while the tangential displacement rises)
+/// with partial separation (`Q > P`), derived here for the law the element implements (type
+/// docs of `Contact`): the phases `(from, to, α, β, γ)` of one cycle, `T = α + β cos θ + γ sin θ`,
+/// the open interval (`T = 0`) left out. `K = k_t a`, `P = μN0`, `Q = μ k_n b` as in
+/// [`closed_form`].
+///
+/// The threshold is `F(θ) = P − Q cos θ`, least where `u_t = a` (θ = 0). The contact is open
+/// while `N0 + k_n u_n < 0`, i.e. `F < 0`, on `|θ| < θ_o`, `cos θ_o = P/Q`. While open the
+/// element sets `T = 0` and `w = u_t` (the spring unloads), so it re-closes at θ_o with the
+/// slider where the contact closes, `T(θ_o) = 0 = F(θ_o)`, whatever came before: the cycle has
+/// no memory across the open interval and the motion below is the periodic one at once.
+///
+/// On the closed interval `(θ_o, 2π − θ_o)`, centred on `u_t = −a`, `N = N0 + k_n b` at θ = π,
+/// a stuck spring moves T at `dT/dθ = −K sin θ` while the bounds `±F` move at `±Q sin θ`:
+/// - `K > Q`, the spring outruns the threshold from the re-contact on (the closing rule of
+///   [`EventReference::next`]): backward slip, `T = −F(θ)`, which goes on while
+///   `K sin θ − Q sin θ > 0` (the backward-slip margin of [`closed_form`] with φ = π), i.e. up
+///   to the reversal at π, `T(π) = −(P + Q)`. Stick, `T = −(P + Q) + K (1 + cos θ)`: T rises at
+///   `−K sin θ`, faster than the lower bound `−F` (at `−Q sin θ`), and meets the falling upper
+///   bound `T = F` at θ₂ ∈ (π, 2π), `(K + Q) cos θ₂ = 2P + Q − K`. This happens before the
+///   opening at `2π − θ_o`, where the stuck force would be `(K − Q)(P + Q)/Q > 0 = F`
+///   (equivalently `cos θ₂ < P/Q ⇔ Q < K`). Forward slip, `T = F(θ)`, which goes on while
+///   `−(K + Q) sin θ > 0`, i.e. until the contact opens at `2π − θ_o` with `T = F = 0`: no stick
+///   between the forward slip and the opening. With `u = a cos θ` as variable the three phases
+///   integrate to `W = a (P + Q)² (K − Q) / (Q (K + Q))`.
+/// - `K ≤ Q`, the threshold outruns the spring: stick from the re-contact,
+///   `T = K (cos θ − cos θ_o) = K (cos θ − P/Q)`, and then `F − T = (Q + K)(P/Q − cos θ)` and
+///   `F + T = (Q − K)(P/Q − cos θ)` stay ≥ 0 over the whole closed interval: stuck until the
+///   contact opens, where T = 0 again. T is a single-valued function of `u_t`: `W = 0`, and
+///   harmonic 1 is a pure stiffness (`s₁ = 0`).
+///
+/// Every switch angle is an explicit arccosine here (the normal and tangential motions share
+/// their zeros of `sin θ`), so no root finder is needed.
+fn opposite_phase_with_separation(k: f64, p: f64, q: f64) -> Vec<(f64, f64, f64, f64, f64)> {
+    assert!(q > p, "partial separation");
+    let theta_open = (p / q).acos();
+    if k > q {
+        let theta2 = 2.0 * PI - ((2.0 * p + q - k) / (k + q)).acos();
+        assert!(PI < theta2 && theta2 < 2.0 * PI - theta_open, "stick ends before the opening");
+        vec![(theta_open, PI, -p, q, 0.0), (PI, theta2, k - p - q, k, 0.0), (theta2, 2.0 * PI - theta_open, p, -q, 0.0)]
+    } else {
+        vec![(theta_open, 2.0 * PI - theta_open, -k * p / q, k, 0.0)]
+    }
 }
 
 #[test]
@@ -647,5 +695,93 @@ fn variable_normal_load_matches_the_closed_forms() {
             (w_ref - w) / w,
             (w_aft - w) / w
         );
+    }
+}
+
+#[test]
+fn opposite_phase_with_partial_separation_matches_the_closed_form() {
+    // k_t = 1e6 N/m, k_n = 2e6 N/m, μ = 0.4, N0 = 400 N (P = 160 N) as above, φ = π; the
+    // contact is open over 2θ_o/2π = acos(P/Q)/π of the cycle.
+    let (kt, kn, mu, n0) = (1e6, 2e6, 0.4, 400.0);
+    let law = Contact::new_2d(kt, kn, mu, n0).unwrap();
+    for (what, a, b) in [
+        ("K = 400 N, Q = 240 N, open 27 % of the cycle", 4e-4, 3e-4),
+        ("K = 800 N, Q = 600 N, open 41 %", 8e-4, 7.5e-4),
+        ("K = 200 N, Q = 360 N, open 35 %, stuck while closed", 2e-4, 4.5e-4),
+    ] {
+        let (k, p, q) = (kt * a, mu * n0, mu * kn * b);
+        let theta_open = (p / q).acos();
+        let (w, c1, s1) = closed_form(a, b, PI, kt, kn, mu, n0);
+        let t1 = c1.hypot(s1);
+        // The phase integrals against the energy summed by hand: with u = a cos θ, the backward
+        // slip gives a(P + Q)²/(2Q), the stick and the forward slip the rest, and with
+        // (K + Q) cos θ₂ = 2P + Q − K the sum is W = a (P + Q)² (K − Q) / (Q (K + Q)) for K > Q
+        // (zero at K = Q, continuous with the stuck case), below the rigid-spring limit
+        // a (P + Q)²/Q (slip all the time the contact is closed), the energy scale used when W
+        // vanishes. Same numbers summed differently: round-off, 1e-12.
+        let w_max = a * (p + q).powi(2) / q;
+        let w_hand = if k > q { w_max * (k - q) / (k + q) } else { 0.0 };
+        assert!((w - w_hand).abs() < 1e-12 * w_max, "{what}: W {w} phases, {w_hand} by hand");
+        let w_scale = if k > q { w } else { w_max };
+        assert!(k > q || s1 == 0.0, "{what}: stuck while closed, yet s₁ = {s1}");
+        // The event-resolved solution: switches by bisection to round-off, each phase by
+        // Simpson on 200 intervals, error ≈ (L/200)⁴/180 of the integrand's fourth derivative
+        // over a phase of length L ≤ 2π: ≤ 3e-9 relative for the longest (the stuck case's 4 rad);
+        // measured ≤ 2.2e-9. Bound 1e-8, as for the closed cases.
+        let (w_ref, c_ref, s_ref) = EventReference { a, b, phi: PI, kt, kn, mu, n0 }.solve();
+        let (e_w, e_1) = ((w_ref - w).abs() / w_scale, (c_ref - c1).hypot(s_ref - s1) / t1);
+        println!("{what}: W = {w:.9e} J, k_eq = {:.9e} N/m; events: W {e_w:.1e}, T₁ {e_1:.1e}", c1 / a);
+        assert!(e_w < 1e-8 && e_1 < 1e-8, "{what}: events, W {e_w:.2e}, T₁ {e_1:.2e}");
+        for nt in 300..308 {
+            let (w_aft, g_c1, g_s1) = aft_harmonic_1(&law, nt, a, b, PI);
+            let (e_w, e_1) = ((w_aft - w).abs() / w_scale, (g_c1 - c1).hypot(g_s1 - s1) / t1);
+            if k > q {
+                // Re-contact into a slip: the first closed sample slips at T = −F(θ_j) as the
+                // continuous law does, stick and slip then follow the law at every sample, and
+                // at an odd n_t the stick begins one sample after π with T off by
+                // (K − Q)(π − θ_j)²/2 (second order; π is a sample at even n_t). The AFT's
+                // harmonic 1 is then the trapezoidal rule of a continuous T with slope jumps J_i
+                // at θ_o, θ₂ and 2π − θ_o (Q sin θ_o, (K + Q)|sin θ₂|, Q sin θ_o), second order:
+                // at most |J_i|·Δθ²/12 each (Euler–Maclaurin, |B₂(t)|/2 ≤ 1/12 for a kink at
+                // a fraction t of a step). Worst cases at 300 samples, K = 800 N: W within
+                // a Σ|J_i sin θ_i|Δθ²/12 = 6.7e-4 of W, plus 0.9e-4 from the odd-n_t offset at π;
+                // T₁ within Σ|J_i|Δθ²/(12π) = 7.6e-5 of |T₁|. Measured over 300–307 samples:
+                // ≤ 1.9e-4 (W), 3.7e-5 (T₁). Bound 1e-3, a tenth of the 1 % asked.
+                println!("  {nt} samples: AFT W {e_w:.1e}, T₁ {e_1:.1e}");
+                assert!(e_w < 1e-3 && e_1 < 1e-3, "{what}, {nt} samples: AFT W {e_w:.2e}, T₁ {e_1:.2e}");
+            } else {
+                // Re-contact into a stick: the element resets the slider at the last open
+                // sample θ_{j−1} (w = u_t there), not at θ_o, so the first closed sample θ_j has
+                // T_j = K (cos θ_j − cos θ_{j−1}) if that stays within μN(θ_j), else −μN(θ_j),
+                // where the continuous law has K (cos θ_j − P/Q). The offset
+                // c = T_j − K (cos θ_j − P/Q), |c| ≤ K (1 − K/Q) sin θ_o Δθ (both branches), is
+                // carried by the stick over the whole closed interval and shifts the
+                // harmonic 1 by (1/π)∫c cos θ = −2c sin θ_o/π: a first-order error of the
+                // sampled law, up to 4K (1 − K/Q) sin²θ_o/n_t = 6.2e-3 of |T₁| at 300 samples
+                // (within the 1 % asked, not within 1e-3), which depends on where θ_o falls
+                // between samples: 1.5e-4 at 300, 5.0e-3 at 303. Asserted: that bound, and the
+                // predicted shift to a second-order residual (measured ≤ 1.2e-5 of |T₁|,
+                // bound 5e-5, also the allowance on the first bound).
+                let h = 2.0 * PI / nt as f64;
+                let j = (theta_open / h).floor() + 1.0;
+                let (tj, tp) = (j * h, (j - 1.0) * h);
+                let (trial, limit) = (k * (tj.cos() - tp.cos()), p - q * tj.cos());
+                let c = if trial.abs() < limit { trial } else { -limit } - k * (tj.cos() - p / q);
+                let c_max = k * (1.0 - k / q) * theta_open.sin() * h;
+                assert!(c.abs() <= c_max, "{what}, {nt} samples: offset {c} N beyond {c_max} N");
+                let shift = -2.0 * c * theta_open.sin() / PI;
+                let residual = (g_c1 - c1 - shift).hypot(g_s1 - s1) / t1;
+                let bound = 2.0 * c_max * theta_open.sin() / PI / t1;
+                // Dissipation: only a slip just before the opening, where the offset pushes T
+                // onto −F: the slider moves at most |c|/k_t under a force at most |c|.
+                let w_bound = c_max * c_max / kt / w_scale;
+                println!("  {nt} samples: AFT W {e_w:.1e} (bound {w_bound:.1e}), T₁ {e_1:.1e} (bound {bound:.1e}, beyond the predicted shift {residual:.1e})");
+                assert!(e_w <= w_bound, "{what}, {nt} samples: AFT W {e_w:.2e}");
+                assert!(
+                    e_1 <= bound + 5e-5 && residual < 5e-5,
+                    "{what}, {nt} samples: AFT T₁ {e_1:.2e}, {residual:.2e}"
+                );
+            }
+        }
     }
 }
