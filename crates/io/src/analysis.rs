@@ -384,13 +384,27 @@ impl<'a> LevelSweeper<'a> {
             }
             _ => Vec::new(),
         };
-        let note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
+        let start_note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
             format!(
                 "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
                 (p.lambda / TWO_PI - study.sweep.start_hz).abs(),
                 p.lambda / TWO_PI
             )
         });
+        // A branch that stopped: at its last point, or where Newton last stopped beyond it.
+        let singular_note = match (&branch.termination, branch.points.last(), &mut hbm) {
+            (TerminationReason::StepTooSmall { last_iterate, .. }, Some(last), Balance::Penalty(hbm)) => {
+                singular_directions(hbm, &last.x, last.lambda, level, "the last point").or_else(|| {
+                    let (x, omega) = last_iterate.as_ref()?;
+                    singular_directions(hbm, x, *omega, level, "the last Newton iterate beyond it")
+                })
+            }
+            _ => None,
+        };
+        let note = match (start_note, singular_note) {
+            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+            (a, b) => a.or(b),
+        };
         Ok(LevelRun {
             note,
             newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
@@ -682,6 +696,50 @@ pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool
     }
 }
 
+/// Largest balance whose Jacobian a stopped branch has decomposed to explain the stop (a dense
+/// SVD, O(n³): a second at 2000 unknowns).
+const DIAGNOSED_UP_TO: usize = 2000;
+
+/// Why a branch may have stopped where it did: when the balance's Jacobian at its last point
+/// is singular to round-off (smallest singular value below 1e-10 of the largest), the periodic
+/// solutions there are not isolated and no step can be taken along a unique branch. Said with
+/// where its null vector lies: in the mean (harmonic 0) of the joints' displacements, the sign
+/// of a part held by friction alone, whose mean position nothing fixes once every joint
+/// holding it slips during the cycle.
+fn singular_directions(hbm: &mut CondensedHbm<'_>, x: &[f64], omega: f64, level: f64, where_: &str) -> Option<String> {
+    let n = hbm.dimension();
+    if n > DIAGNOSED_UP_TO || !x.iter().all(|v| v.is_finite()) || !omega.is_finite() {
+        return None;
+    }
+    let mut residual = vec![0.0; n];
+    let mut jacobian = faer::Mat::<f64>::zeros(n, n);
+    let jacobians = stickslip_core::hbm::Jacobians { dx: jacobian.as_mut(), domega: None, dlevel: None };
+    hbm.evaluate(x, omega, level, &mut residual, Some(jacobians)).ok()?;
+    let svd = jacobian.svd().ok()?;
+    let s = svd.S().column_vector();
+    let (largest, smallest) = (s[0], s[n - 1]);
+    if smallest.is_nan() || smallest > 1e-10 * largest {
+        return None;
+    }
+    // The null vector: the last right singular vector; its share in harmonic 0 (the first q).
+    let v = svd.V().col(n - 1);
+    let q = hbm.n_directions();
+    let mean_share: f64 = (0..q).map(|i| v[i] * v[i]).sum::<f64>() / (0..n).map(|i| v[i] * v[i]).sum::<f64>();
+    let what = if mean_share >= 0.9 {
+        format!(
+            "its null vector lies in the mean (harmonic 0) of the joints' displacements ({:.1} %): a part held by the joints alone has no fixed mean position once each of them slips during the cycle; hold it elastically as well (a spring in K the joints do not replace) or lower the level",
+            100.0 * mean_share
+        )
+    } else {
+        format!("its null vector has {:.1} % of its norm in harmonic 0", 100.0 * mean_share)
+    };
+    Some(format!(
+        "at {where_}, {:.6} Hz, the harmonic balance's Jacobian is singular (smallest singular value {:.1e} of the largest): the periodic solutions there are not isolated and the branch cannot be followed uniquely; {what}",
+        omega / TWO_PI,
+        smallest / largest
+    ))
+}
+
 /// Say why a branch ended, for users.
 pub fn describe_termination(t: &TerminationReason) -> String {
     match t {
@@ -692,7 +750,7 @@ pub fn describe_termination(t: &TerminationReason) -> String {
             "no convergence at the first point, {:.3} Hz, after {iterations} Newton iterations (residual {residual_norm:.3e}): start the band where the response is closer to linear, or use more harmonics",
             lambda / TWO_PI
         ),
-        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations } => {
+        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations, .. } => {
             let advice = match rejection {
                 Rejection::NewtonCycle => {
                     "; with a stiff friction joint this is a time sample switching between stick and slip: try more [harmonic_balance] samples (e.g. 512)"

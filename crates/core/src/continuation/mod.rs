@@ -349,6 +349,9 @@ pub enum TerminationReason {
         leaps: usize,
         /// Newton iterations spent on them.
         iterations: usize,
+        /// The last iterate of the last failed correction, `(x, λ)`: where Newton stopped
+        /// (e.g. at a singular Jacobian), to diagnose the stop.
+        last_iterate: Option<(Vec<f64>, f64)>,
     },
     /// The problem returned an error when evaluated at `lambda`.
     ProblemError {
@@ -371,7 +374,9 @@ impl std::fmt::Display for TerminationReason {
                 "no solution found at the start λ = {lambda}: Newton from the initial guess ended at residual \
                  {residual_norm:.3e} after {iterations} iterations"
             ),
-            TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations } => {
+            TerminationReason::StepTooSmall {
+                rejection, lambda, residual_norm, attempts, leaps, iterations, ..
+            } => {
                 write!(
                     f,
                     "no step accepted after the point at λ = {lambda}: {attempts} steps tried, each half the previous \

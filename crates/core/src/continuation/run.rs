@@ -152,6 +152,7 @@ impl StepControl {
             attempts: self.attempts,
             leaps: self.leaps,
             iterations: self.failed_iterations,
+            last_iterate: None,
         })
     }
 
@@ -319,7 +320,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                 Outcome::Converged { iterations, residual_norm } => (iterations, residual_norm),
                 Outcome::Failed { iterations, residual_norm, cause } => {
                     match control.reject(cause, iterations, residual_norm, last_lambda, options) {
-                        Some(termination) => return termination,
+                        Some(termination) => return self.with_last_iterate(termination),
                         None => continue,
                     }
                 }
@@ -383,7 +384,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             }
             if let Some(rejection) = rejection {
                 match control.reject(rejection, iterations, residual_norm, last_lambda, options) {
-                    Some(termination) => return termination,
+                    Some(termination) => return self.with_last_iterate(termination),
                     None => continue,
                 }
             }
@@ -417,6 +418,27 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
 
             // ADAPT STEP
             control.accept(iterations, options);
+        }
+    }
+
+    /// A termination for want of a step, with the last iterate of the failed correction.
+    fn with_last_iterate(&self, termination: TerminationReason) -> TerminationReason {
+        match termination {
+            TerminationReason::StepTooSmall {
+                rejection, lambda, residual_norm, attempts, leaps, iterations, ..
+            } => {
+                let x = self.z[..self.n].iter().map(|u| u * self.scale.x).collect();
+                TerminationReason::StepTooSmall {
+                    rejection,
+                    lambda,
+                    residual_norm,
+                    attempts,
+                    leaps,
+                    iterations,
+                    last_iterate: Some((x, self.z[self.n] * self.scale.lambda)),
+                }
+            }
+            other => other,
         }
     }
 
