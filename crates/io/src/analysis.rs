@@ -93,12 +93,19 @@ pub struct LevelRun {
     pub evaluations: usize,
     /// What the sweep did that the user should know (e.g. a start moved off a resonance).
     pub note: Option<String>,
+    /// For a branch that stopped short, what was found where it stopped (a singular balance).
+    pub diagnosis: Option<String>,
 }
 
 impl LevelRun {
     /// Did the branch cross the whole band?
     pub fn is_complete(&self) -> bool {
         matches!(self.termination, TerminationReason::ReachedEnd)
+    }
+
+    /// Why the branch ended, for users, with the diagnosis of a stop.
+    pub fn ending(&self) -> String {
+        describe_termination_with(&self.termination, self.diagnosis.as_deref())
     }
 }
 
@@ -401,12 +408,9 @@ impl<'a> LevelSweeper<'a> {
             }
             _ => None,
         };
-        let note = match (start_note, singular_note) {
-            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
-            (a, b) => a.or(b),
-        };
         Ok(LevelRun {
-            note,
+            note: start_note,
+            diagnosis: singular_note,
             newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
             evaluations: branch.calls.residuals,
             result: LevelResult { level_n: level, points, peaks, bifurcations },
@@ -742,6 +746,12 @@ fn singular_directions(hbm: &mut CondensedHbm<'_>, x: &[f64], omega: f64, level:
 
 /// Say why a branch ended, for users.
 pub fn describe_termination(t: &TerminationReason) -> String {
+    describe_termination_with(t, None)
+}
+
+/// [`describe_termination`], with what was found where a branch stopped short in place of the
+/// general advice.
+fn describe_termination_with(t: &TerminationReason, diagnosis: Option<&str>) -> String {
     match t {
         TerminationReason::ReachedEnd => "reached the end of the band".into(),
         TerminationReason::ReturnedToStart => "came back to the start of the band after a fold".into(),
@@ -752,13 +762,15 @@ pub fn describe_termination(t: &TerminationReason) -> String {
         ),
         TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations, .. } => {
             let advice = match rejection {
+                _ if diagnosis.is_some() => "",
                 Rejection::NewtonCycle => {
                     "; with a stiff friction joint this is a time sample switching between stick and slip: try more [harmonic_balance] samples (e.g. 512)"
                 }
                 _ => "; try a smaller [continuation] min_step_hz, more [harmonic_balance] samples or another predictor",
             };
+            let diagnosis = diagnosis.map(|d| format!("; {d}")).unwrap_or_default();
             format!(
-                "stopped after {:.3} Hz: {attempts} steps failed, ever smaller down to [continuation] min_step_hz, then {leaps} leaps ever longer ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}{advice}",
+                "stopped after {:.3} Hz: {attempts} steps failed, ever smaller down to [continuation] min_step_hz, then {leaps} leaps ever longer ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}{advice}{diagnosis}",
                 lambda / TWO_PI
             )
         }
@@ -805,8 +817,8 @@ pub fn report_data(
                 points: r.result.points.len(),
                 complete: r.is_complete(),
                 ending: match &r.note {
-                    Some(note) => format!("{}; {note}", describe_termination(&r.termination)),
-                    None => describe_termination(&r.termination),
+                    Some(note) => format!("{}; {note}", r.ending()),
+                    None => r.ending(),
                 },
             })
             .collect(),

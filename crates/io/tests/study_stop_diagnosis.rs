@@ -3,7 +3,7 @@
 //! has no fixed mean position once the joint slips during the cycle, since the slip resets its
 //! anchor. The condensed balance's harmonic-0 equation `x₀ + H(0) G₀ = 0` is then
 //! `(mean friction force)/k = 0` whatever x₀: its Jacobian has the mean as null vector, and no
-//! continuation step can be taken. The run's note names the singular Jacobian and the mean.
+//! continuation step can be taken. The level says so where it says why the branch stopped.
 
 use stickslip_core::continuation::{Silent, TerminationReason};
 use stickslip_io::analysis::run_level;
@@ -51,14 +51,21 @@ fn note_at(text: &str, level: f64) -> (TerminationReason, Option<String>) {
     let study = Study::parse(text, "study.toml").unwrap();
     let (model, excitation, outputs) = study.build_model().unwrap();
     let run = run_level(&study, &model, &excitation, &outputs, level, &mut Silent).unwrap();
-    (run.termination, run.note)
+    // The reason users read (the run's summary, Python's `ending`, the report) carries the
+    // diagnosis in place of the general advice on steps and samples.
+    let ending = run.ending();
+    match &run.diagnosis {
+        Some(d) => assert!(ending.ends_with(d.as_str()) && !ending.contains("min_step_hz, more"), "{ending}"),
+        None => assert!(!ending.contains("singular value"), "{ending}"),
+    }
+    (run.termination, run.diagnosis)
 }
 
 #[test]
 fn a_mass_held_by_a_slipping_joint_alone_is_diagnosed() {
     let (termination, note) = note_at(HELD_BY_FRICTION, 5.0);
     assert!(matches!(termination, TerminationReason::StepTooSmall { .. }), "{termination:?}");
-    let note = note.expect("a note on the stop");
+    let note = note.expect("a diagnosis of the stop");
     assert!(note.contains("Jacobian is singular"), "{note}");
     assert!(note.contains("mean (harmonic 0)"), "{note}");
     // The mean is an exact null vector (the harmonic-0 row and column vanish): the singular

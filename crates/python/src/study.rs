@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
 use stickslip_core::timesim::{steady_state, SteadyStateOptions};
-use stickslip_io::analysis::{describe_termination, LevelRun, LevelSweeper};
+use stickslip_io::analysis::{LevelRun, LevelSweeper};
 use stickslip_io::output::{frf_columns, frf_row, LevelResult, PointRecord};
 use stickslip_io::study::Study as IoStudy;
 
@@ -204,7 +204,7 @@ pub(crate) fn results_dict<'py>(py: Python<'py>, runs: &[LevelRun]) -> PyResult<
             l.set_item("level_N", r.result.level_n)?;
             l.set_item("points", r.result.points.len())?;
             l.set_item("complete", r.is_complete())?;
-            l.set_item("ending", describe_termination(&r.termination))?;
+            l.set_item("ending", r.ending())?;
             l.set_item("newton_iterations", r.newton_iterations)?;
             l.set_item("evaluations", r.evaluations)?;
             Ok(l)

@@ -209,7 +209,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let incomplete: Vec<String> = runs
         .iter()
         .filter(|r| !r.is_complete())
-        .map(|r| format!("level {} N {}", r.result.level_n, describe_termination(&r.termination)))
+        .map(|r| format!("level {} N {}", r.result.level_n, r.ending()))
         .collect();
     let failed: Vec<String> = failed_snapshots
         .into_iter()

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 pub use design::{design, Design, Values, Vary};
 pub use keys::{KeyPath, NumberKind};
 
-use crate::analysis::{describe_termination, LevelSweeper};
+use crate::analysis::LevelSweeper;
 use crate::output::LevelResult;
 use crate::study::{LinearBase, Study, StudyError};
 
@@ -298,7 +298,7 @@ impl<'a> SampleRunner<'a> {
             let run = sweeper
                 .run(level, &mut |_: &_, _: f64| {})
                 .map_err(|e| ParamError::Design(format!("level {level} N: {e}")))?;
-            rows.push(summarise(&run.result, which, run.is_complete(), describe_termination(&run.termination)));
+            rows.push(summarise(&run.result, which, run.is_complete(), run.ending()));
             if curves {
                 levels.push(run.result);
             }
