@@ -14,6 +14,7 @@ use stickslip_core::continuation::{
 };
 use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::dlft::{self, DlftFrequencySweep, DlftHbm};
+use stickslip_core::hbm::receptance::Outputs;
 use stickslip_core::hbm::{
     bifurcations, nonlinear_mode, stability_at_last_evaluation, sweep_frequency, sweep_level, Backbone,
     BranchStabilityError, CondensedHbm, FrequencySweep, HbmError, HbmSettings as CoreHbmSettings, Hill, HillSettings,
@@ -254,16 +255,28 @@ impl FrequencyProblem<'_, '_> {
         }
     }
 
-    /// |X₁| of `selector` at the solution `x`, Ω: for the penalty balance recovered alone from
-    /// the evaluation that solved the point (core `output_amplitude`), for DLFT from the
-    /// point's results.
-    fn peak_quantity(&mut self, x: &[f64], omega: f64, selector: &OutputSelector) -> Result<f64, HbmError> {
+    /// `selector` prepared for the recovery of the penalty balance's outputs (its modal
+    /// projection, made once per peak rather than at every point of the bracket).
+    fn prepare(&self, selector: &OutputSelector) -> Outputs {
+        match self {
+            FrequencyProblem::Penalty(p) => p.hbm.receptance().outputs(&[&selector.vector]),
+            FrequencyProblem::Dlft(p) => p.dlft.receptance().outputs(&[&selector.vector]),
+        }
+    }
+
+    /// |X₁| of `selector` (`prepared` by [`Self::prepare`]) at the solution `x`, Ω: for the
+    /// penalty balance recovered alone from the evaluation that solved the point (core
+    /// `output_amplitude`), for DLFT from the point's results.
+    fn peak_quantity(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        selector: &OutputSelector,
+        prepared: &Outputs,
+    ) -> Result<f64, HbmError> {
         let level = self.level();
         match self {
-            FrequencyProblem::Penalty(p) => {
-                let prepared = p.hbm.receptance().outputs(&[&selector.vector]);
-                output_amplitude(p.hbm, x, omega, level, &prepared, 1)
-            }
+            FrequencyProblem::Penalty(p) => output_amplitude(p.hbm, x, omega, level, prepared, 1),
             FrequencyProblem::Dlft(p) => {
                 let r = evaluate_dlft_point(p.dlft, x, omega, level, std::slice::from_ref(selector))?;
                 Ok(r.outputs[0].harmonic(1).0)
@@ -536,12 +549,13 @@ fn locate_peaks(
             continue;
         }
         let mut problem = hbm.frequency_problem(level);
+        let prepared = problem.prepare(selector);
         let bracket = brackets.entry(i).or_insert_with(|| {
             Bracket::new(&mut problem, [&branch.points[i - 1], &branch.points[i], &branch.points[i + 1]]).ok()
         });
         let found = bracket.as_mut().map(|bracket| {
             bracket.maximise(&mut problem, PEAK_TOLERANCE, |p, x, omega| {
-                p.peak_quantity(x, omega, selector).map_err(|e| ProblemError::new(e.to_string()))
+                p.peak_quantity(x, omega, selector, &prepared).map_err(|e| ProblemError::new(e.to_string()))
             })
         });
         peaks.push(match found {

@@ -422,24 +422,12 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
     }
 
     /// A termination for want of a step, with the last iterate of the failed correction.
-    fn with_last_iterate(&self, termination: TerminationReason) -> TerminationReason {
-        match termination {
-            TerminationReason::StepTooSmall {
-                rejection, lambda, residual_norm, attempts, leaps, iterations, ..
-            } => {
-                let x = self.z[..self.n].iter().map(|u| u * self.scale.x).collect();
-                TerminationReason::StepTooSmall {
-                    rejection,
-                    lambda,
-                    residual_norm,
-                    attempts,
-                    leaps,
-                    iterations,
-                    last_iterate: Some((x, self.z[self.n] * self.scale.lambda)),
-                }
-            }
-            other => other,
+    fn with_last_iterate(&self, mut termination: TerminationReason) -> TerminationReason {
+        if let TerminationReason::StepTooSmall { last_iterate, .. } = &mut termination {
+            let x = self.z[..self.n].iter().map(|u| u * self.scale.x).collect();
+            *last_iterate = Some((x, self.z[self.n] * self.scale.lambda));
         }
+        termination
     }
 
     /// Hand an accepted point to the observer, the problem as the converged evaluation left it.
