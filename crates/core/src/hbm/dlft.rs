@@ -101,10 +101,8 @@ use super::condensed::{HbmError, HbmSettings, Jacobians};
 use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
-use super::sweep::{off_resonance_of, SweepError};
-use crate::continuation::{
-    continue_branch, Branch, Options, PointObserver, Problem, ProblemError, Scales, Silent, TerminationReason,
-};
+use super::sweep::{from_level_ramp, off_resonance_of, SweepError};
+use crate::continuation::{continue_branch, Branch, Options, PointObserver, Problem, ProblemError, Scales, Silent};
 use crate::elements::{Contact, ElementError};
 use crate::model::{LinearModel, ModelError, NonlinearModel};
 
@@ -657,21 +655,16 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
     let free = level * dlft.free_response_norm(omega_start);
     let unknowns_scale = (free.is_finite() && free > 0.0).then_some(free);
     let guess = dlft.stuck_solution();
-    let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
-    let branch = continue_branch(&mut problem, &guess, omega_start, omega_end, options, observer)?;
-    if !matches!(branch.termination, TerminationReason::FirstPointFailed { .. }) {
-        return Ok(branch);
-    }
-    let ramp = Options { max_points: options.max_points.max(1000), ..options.clone() };
-    let start = sweep_level(dlft, omega_start, 1e-3 * level, level, &ramp, &mut Silent)?;
-    match (&start.termination, start.points.last()) {
-        (TerminationReason::ReachedEnd, Some(p)) => {
-            let guess = p.x.clone();
+    from_level_ramp(
+        dlft,
+        &guess,
+        options,
+        |dlft, guess| {
             let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
-            Ok(continue_branch(&mut problem, &guess, omega_start, omega_end, options, observer)?)
-        }
-        _ => Ok(branch),
-    }
+            continue_branch(&mut problem, guess, omega_start, omega_end, options, observer)
+        },
+        |dlft, ramp| sweep_level(dlft, omega_start, 1e-3 * level, level, ramp, &mut Silent),
+    )
 }
 
 /// Continue the DLFT balance at frequency `omega` (rad/s) in the force level from

@@ -166,20 +166,36 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
 ) -> Result<Branch, SweepError> {
     let omega_start = off_resonance(hbm, omega_start, omega_end, level)?;
     let guess = hbm.stuck_solution(omega_start, level)?;
-    let branch =
-        continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?;
+    from_level_ramp(
+        hbm,
+        &guess,
+        options,
+        |hbm, guess| {
+            continue_branch(&mut FrequencySweep { hbm, level }, guess, omega_start, omega_end, options, observer)
+        },
+        |hbm, ramp| sweep_level(hbm, omega_start, 1e-3 * level, level, ramp, &mut Silent),
+    )
+}
+
+/// A frequency sweep of `balance` from `guess` (`frequency`); when Newton cannot reach its
+/// first point (a joint already slipping hard at the start of the band), the start is found by
+/// `ramp`, a force-level continuation at the first frequency from 1/1000 of the level (stuck
+/// for any joint that slips at less than 1000x the force where it slips at the level), given
+/// its options (at least 1000 points), and the sweep starts again from its last point.
+pub(crate) fn from_level_ramp<B: ?Sized>(
+    balance: &mut B,
+    guess: &[f64],
+    options: &Options,
+    mut frequency: impl FnMut(&mut B, &[f64]) -> Result<Branch, ContinuationError>,
+    ramp: impl FnOnce(&mut B, &Options) -> Result<Branch, SweepError>,
+) -> Result<Branch, SweepError> {
+    let branch = frequency(balance, guess)?;
     if !matches!(branch.termination, TerminationReason::FirstPointFailed { .. }) {
         return Ok(branch);
     }
-    // Force-level continuation from 1/1000 of the level (stuck for any joint that slips at
-    // less than 1000x the force where it slips at `level`).
-    let ramp = Options { max_points: options.max_points.max(1000), ..options.clone() };
-    let start = sweep_level(hbm, omega_start, 1e-3 * level, level, &ramp, &mut Silent)?;
+    let start = ramp(balance, &Options { max_points: options.max_points.max(1000), ..options.clone() })?;
     match (&start.termination, start.points.last()) {
-        (TerminationReason::ReachedEnd, Some(p)) => {
-            let guess = p.x.clone();
-            Ok(continue_branch(&mut FrequencySweep { hbm, level }, &guess, omega_start, omega_end, options, observer)?)
-        }
+        (TerminationReason::ReachedEnd, Some(p)) => Ok(frequency(balance, &p.x)?),
         _ => Ok(branch),
     }
 }
@@ -224,4 +240,80 @@ pub fn sweep_level<'m, O: ?Sized + for<'a> PointObserver<LevelSweep<'a, 'm>>>(
 ) -> Result<Branch, SweepError> {
     let guess = hbm.stuck_solution(omega, level_start)?;
     Ok(continue_branch(&mut LevelSweep { hbm, omega }, &guess, level_start, level_end, options, observer)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuation::{Calls, Point};
+
+    fn branch(termination: TerminationReason, x: &[f64]) -> Branch {
+        let point = Point {
+            x: x.to_vec(),
+            lambda: 1.0,
+            iterations: 1,
+            residual_norm: 0.0,
+            step: 0.0,
+            rejected: 0,
+            calls: Calls::default(),
+        };
+        Branch { points: vec![point], termination, calls: Calls::default(), residual_scale: 1.0 }
+    }
+
+    fn failed() -> TerminationReason {
+        TerminationReason::FirstPointFailed { lambda: 1.0, residual_norm: 1.0, iterations: 50 }
+    }
+
+    /// The guesses the frequency sweep was started from, and the ramps' `max_points`.
+    #[derive(Default)]
+    struct Log {
+        guesses: Vec<Vec<f64>>,
+        ramps: Vec<usize>,
+    }
+
+    fn run(first_fails: bool, ramp_ends: TerminationReason) -> (Branch, Log) {
+        let mut log = Log::default();
+        let options = Options { max_points: 200, ..Options::default() };
+        let result = from_level_ramp(
+            &mut log,
+            &[0.0],
+            &options,
+            |log, guess| {
+                log.guesses.push(guess.to_vec());
+                let fails = first_fails && log.guesses.len() == 1;
+                Ok(branch(if fails { failed() } else { TerminationReason::ReachedEnd }, &[10.0 + guess[0]]))
+            },
+            |log, ramp| {
+                log.ramps.push(ramp.max_points);
+                Ok(branch(ramp_ends, &[7.0]))
+            },
+        )
+        .unwrap();
+        (result, log)
+    }
+
+    #[test]
+    fn a_sweep_whose_first_point_converges_needs_no_ramp() {
+        let (result, log) = run(false, TerminationReason::ReachedEnd);
+        assert_eq!(result.termination, TerminationReason::ReachedEnd);
+        assert_eq!(log.guesses, [vec![0.0]]);
+        assert!(log.ramps.is_empty());
+    }
+
+    #[test]
+    fn a_failed_first_point_is_reached_by_the_ramp_and_the_sweep_starts_again_from_its_end() {
+        let (result, log) = run(true, TerminationReason::ReachedEnd);
+        assert_eq!(result.termination, TerminationReason::ReachedEnd);
+        // Started again from the ramp's last point, the ramp allowed at least 1000 points.
+        assert_eq!(log.guesses, [vec![0.0], vec![7.0]]);
+        assert_eq!(log.ramps, [1000]);
+        assert_eq!(result.points[0].x, [17.0]);
+    }
+
+    #[test]
+    fn a_ramp_that_does_not_reach_the_level_leaves_the_first_failure() {
+        let (result, log) = run(true, TerminationReason::MaxPoints);
+        assert!(matches!(result.termination, TerminationReason::FirstPointFailed { .. }));
+        assert_eq!(log.guesses.len(), 1);
+    }
 }
