@@ -137,11 +137,12 @@ fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds
     assert!((found[0].lambda - found[1].lambda).abs() > 1e-4 * wn);
     // Each later search solved only the lattice points outside the earlier windows and its own
     // Brent steps: the power's window is the amplitude's, so its search solved only Brent's
-    // steps (to 1e-9, at most ~20), against a whole scan (16 points or more) besides alone.
+    // steps (to 1e-9, at most ~20), against a scan besides alone (each side of the vertex down
+    // the flank to two points DROP below the best: 5 points at least, 9 here).
     assert_eq!(found[0].solves, alone[0].solves);
     assert!(found[1].solves < alone[1].solves, "{} solves shared, {} alone", found[1].solves, alone[1].solves);
     assert!(
-        found[2].solves <= 20 && alone[2].solves >= found[2].solves + 16,
+        found[2].solves <= 20 && alone[2].solves >= found[2].solves + 5,
         "{} shared, {} alone",
         found[2].solves,
         alone[2].solves

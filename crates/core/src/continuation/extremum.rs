@@ -45,8 +45,8 @@ const MAX_ITERATIONS: usize = 30;
 /// the best point is at one of its ends.
 const SCAN_SPACING: f64 = 0.02;
 const WINDOW: f64 = 0.15;
-/// Points within this distance of the last ones solved start from them (two lattice
-/// spacings and a half: the scan's next point, Brent's steps).
+/// Points solved within this distance start a new one (two lattice spacings and a half: the
+/// scan's neighbours, Brent's steps).
 const NEAR: f64 = 2.5 * SCAN_SPACING;
 /// A point is converged when its residual is at most this fraction of its unknowns' norm
 /// (`R = x − λ u_F + H G` is a difference of terms of the size of x: ~1000 ulps of them).
@@ -55,6 +55,10 @@ const ROUND_OFF: f64 = 1e-13;
 /// of the best. The tops of a friction peak's arcs differ by 1e-5 to 1e-4 near the maximum, a
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
 const CANDIDATE: f64 = 2e-4;
+/// A side of the scan stops after two consecutive points this fraction below the best: twice
+/// CANDIDATE, so that an arc whose top is within CANDIDATE of the best (its scanned points
+/// within CANDIDATE and ~4e-5 of it) is never left out.
+const DROP: f64 = 2.0 * CANDIDATE;
 
 /// Locate the maximum of `quantity(problem, x, λ)` along the branch of `problem` between
 /// `before` and `after`, given `middle`, a converged point between them where the quantity is
@@ -84,9 +88,6 @@ pub struct Bracket {
     /// Points solved so far, by `s` (bit pattern: lattice points are computed identically):
     /// `None` where the branch could not be solved.
     solved: BTreeMap<u64, Option<Vec<f64>>>,
-    /// The last two points solved, the guess for a near one.
-    last: Option<(f64, Vec<f64>)>,
-    before_last: Option<(f64, Vec<f64>)>,
     /// Points solved on the branch so far.
     pub solves: usize,
 }
@@ -110,32 +111,55 @@ impl Bracket {
             return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
         }
         let path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
-        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), last: None, before_last: None, solves: 0 })
+        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), solves: 0 })
     }
 
-    /// The point at `s` (scaled), solved once: from the line through the last two points
-    /// solved if they are near (the scan's neighbours, Brent's steps: one or two Newton
-    /// iterations), else from the parabola through the three points. `None` if it cannot be
-    /// solved there.
+    /// The point at `s` (scaled), solved once: from the line through the nearest points
+    /// solved on either side, or the two nearest on one side, if they are near (the scan's
+    /// neighbours, Brent's steps: one or two Newton iterations), else from the parabola
+    /// through the three points. `None` if it cannot be solved there.
     fn point<P: Problem>(&mut self, problem: &mut P, s: f64) -> Result<Option<&[f64]>, ProblemError> {
         let key = s.to_bits();
         if !self.solved.contains_key(&key) {
             let n = self.path.n;
             let mut z = vec![0.0; n + 1];
+            // The nearest points solved on either side (keys of positive `s` sort as `s`).
             let near = |t: f64| (s - t).abs() <= NEAR;
-            match (&self.last, &self.before_last) {
-                (Some((s1, z1)), Some((s0, z0))) if near(*s1) && near(*s0) && s1 != s0 => {
+            let below: Vec<(f64, &Vec<f64>)> = self
+                .solved
+                .range(..key)
+                .rev()
+                .filter_map(|(k, z)| Some((f64::from_bits(*k), z.as_ref()?)))
+                .take_while(|(t, _)| near(*t))
+                .take(2)
+                .collect();
+            let above: Vec<(f64, &Vec<f64>)> = self
+                .solved
+                .range(key..)
+                .filter_map(|(k, z)| Some((f64::from_bits(*k), z.as_ref()?)))
+                .take_while(|(t, _)| near(*t))
+                .take(2)
+                .collect();
+            // Between two solved points, the line through them; else the line through the two
+            // nearest on one side; else a shift along the chord from the one nearest; else
+            // the parabola through the bracket's three points.
+            let line = match (below.first(), above.first()) {
+                (Some(a), Some(b)) => Some((*a, *b)),
+                _ => below.get(1).map(|b| (below[0], *b)).or_else(|| above.get(1).map(|b| (above[0], *b))),
+            };
+            match (line, below.first().or(above.first())) {
+                (Some(((s1, z1), (s0, z0))), _) => {
                     let t = (s - s1) / (s1 - s0);
                     for i in 0..=n {
                         z[i] = z1[i] + t * (z1[i] - z0[i]);
                     }
                 }
-                (Some((s1, z1)), _) if near(*s1) => {
+                (None, Some((s1, z1))) => {
                     for i in 0..=n {
                         z[i] = z1[i] + (s - s1) * self.path.chord[i];
                     }
                 }
-                _ => {
+                (None, None) => {
                     let sm = self.sm;
                     let (l0, lm, l1) =
                         ((s - sm) * (s - 1.0) / sm, s * (s - 1.0) / (sm * (sm - 1.0)), s * (s - sm) / (1.0 - sm));
@@ -146,9 +170,6 @@ impl Bracket {
             }
             self.solves += 1;
             let solved = self.path.solve(problem, s, &mut z)?;
-            if solved {
-                self.before_last = self.last.replace((s, z.clone()));
-            }
             self.solved.insert(key, solved.then_some(z));
         }
         Ok(self.solved[&key].as_deref())
@@ -211,9 +232,28 @@ impl Bracket {
             ((vertex.min(sm) - WINDOW) / SCAN_SPACING).ceil() as i64,
             ((vertex.max(sm) + WINDOW) / SCAN_SPACING).floor() as i64,
         );
-        for k in first..=last {
-            if lattice(k) > 0.0 && lattice(k) < 1.0 {
-                samples.push((lattice(k), value_at(self, problem, lattice(k))?));
+        // Scanned outward from the vertex, each side until the window's end or until two
+        // consecutive points lie more than DROP below the best: the peak's flank, where no arc
+        // can rise to within CANDIDATE of the top.
+        let centre = ((vertex / SCAN_SPACING).round() as i64).clamp(first, last);
+        let mut top = fm;
+        for side in [1i64, -1] {
+            let mut low = 0;
+            let mut k = if side == 1 { centre } else { centre - 1 };
+            while (first..=last).contains(&k) && low < 2 {
+                if lattice(k) > 0.0 && lattice(k) < 1.0 {
+                    let value = value_at(self, problem, lattice(k))?;
+                    samples.push((lattice(k), value));
+                    top = top.max(value);
+                    low = if value < top - DROP * top.abs() { low + 1 } else { 0 };
+                }
+                k += side;
+            }
+            // The window ends where this side's scan stopped.
+            if side == 1 {
+                last = k - side;
+            } else {
+                first = k - side;
             }
         }
         // Widened while the best scanned point is at an end of the window: the vertex of the
