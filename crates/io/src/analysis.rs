@@ -411,6 +411,15 @@ impl<'a> LevelSweeper<'a> {
                 p.lambda / TWO_PI
             )
         });
+        let resumed_notes = branch.resumed.iter().map(|r| {
+            format!(
+                "the continuation stopped after {:.6} Hz (every step and leap failed) and was resumed: started again at {:.6} Hz and followed back to the stop, it arrived at the same solution, and the branch goes on from there",
+                r.stopped_at / TWO_PI,
+                r.restarted_at / TWO_PI
+            )
+        });
+        let note = start_note.into_iter().chain(resumed_notes).collect::<Vec<_>>();
+        let note = (!note.is_empty()).then(|| note.join("; "));
         // A branch that stopped: at its last point, or where Newton last stopped beyond it.
         let singular_note = match (&branch.termination, branch.points.last(), &mut hbm) {
             (TerminationReason::StepTooSmall { last_iterate, .. }, Some(last), Balance::Penalty(hbm)) => {
@@ -422,7 +431,7 @@ impl<'a> LevelSweeper<'a> {
             _ => None,
         };
         Ok(LevelRun {
-            note: start_note,
+            note,
             diagnosis: singular_note,
             newton_iterations: branch.points.iter().map(|p| p.iterations).sum(),
             evaluations: branch.calls.residuals,

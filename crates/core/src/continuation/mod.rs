@@ -449,6 +449,19 @@ pub struct Branch {
     /// `‖R‖ ≤ max(rtol s_R, atol)`, so `Point::residual_norm / residual_scale` is the measure the
     /// tolerance applies to.
     pub residual_scale: f64,
+    /// Stops before the end past which the branch was resumed (a frequency sweep started
+    /// afresh beyond the stop and followed back to it, `hbm::sweep`): empty for a branch
+    /// continued in one run.
+    pub resumed: Vec<Resumption>,
+}
+
+/// Where a branch stopped before its end and was resumed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resumption {
+    /// λ of the last point before the stop.
+    pub stopped_at: f64,
+    /// λ where the branch was started afresh and followed back to the stop.
+    pub restarted_at: f64,
 }
 
 /// Receives every converged point as it is accepted (progress, the points alone). An observer

@@ -44,7 +44,7 @@ pub fn continue_branch<P: Problem + ?Sized, O: PointObserver<P> + ?Sized>(
     runner.scale.x = scales.unknowns.unwrap_or_else(|| positive_or_one(norm(x_guess)));
     let mut points = Vec::new();
     let termination = runner.run(x_guess, scales.residual, observer, &mut points);
-    Ok(Branch { points, termination, calls: runner.total, residual_scale: runner.scale.residual })
+    Ok(Branch { points, termination, calls: runner.total, residual_scale: runner.scale.residual, resumed: Vec::new() })
 }
 
 fn norm(v: &[f64]) -> f64 {

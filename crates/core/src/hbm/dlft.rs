@@ -101,7 +101,7 @@ use super::condensed::{HbmError, HbmSettings, Jacobians};
 use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
-use super::sweep::{from_level_ramp, off_resonance_of, SweepError};
+use super::sweep::{from_level_ramp, off_resonance_of, resumed_past_stops, within, SweepError};
 use crate::continuation::{continue_branch, Branch, Options, PointObserver, Problem, ProblemError, Scales, Silent};
 use crate::elements::{Contact, ElementError};
 use crate::model::{LinearModel, ModelError, NonlinearModel};
@@ -655,7 +655,10 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
     let free = level * dlft.free_response_norm(omega_start);
     let unknowns_scale = (free.is_finite() && free > 0.0).then_some(free);
     let guess = dlft.stuck_solution();
-    from_level_ramp(
+    let ramp = |omega: f64| {
+        move |dlft: &mut DlftHbm, ramp: &Options| sweep_level(dlft, omega, 1e-3 * level, level, ramp, &mut Silent)
+    };
+    let branch = from_level_ramp(
         dlft,
         &guess,
         options,
@@ -663,7 +666,39 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
             let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
             continue_branch(&mut problem, guess, omega_start, omega_end, options, observer)
         },
-        |dlft, ramp| sweep_level(dlft, omega_start, 1e-3 * level, level, ramp, &mut Silent),
+        ramp(omega_start),
+    )?;
+    let band = (omega_end - omega_start).abs();
+    resumed_past_stops(
+        dlft,
+        branch,
+        omega_end,
+        options,
+        band,
+        |dlft, guess, from, to| {
+            let bridge = within(options, band, from, to);
+            from_level_ramp(
+                dlft,
+                guess,
+                &bridge,
+                |dlft, guess| {
+                    let mut problem = DlftFrequencySweep { dlft, level, unknowns_scale };
+                    continue_branch(&mut problem, guess, from, to, &bridge, &mut Silent)
+                },
+                ramp(from),
+            )
+        },
+        |dlft, guess, from| {
+            let rest = within(options, band, from, omega_end);
+            continue_branch(
+                &mut DlftFrequencySweep { dlft, level, unknowns_scale },
+                guess,
+                from,
+                omega_end,
+                &rest,
+                observer,
+            )
+        },
     )
 }
 

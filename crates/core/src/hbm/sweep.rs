@@ -7,7 +7,7 @@ use faer::MatMut;
 use super::condensed::{CondensedHbm, HbmError, Jacobians};
 use crate::continuation::{
     continue_branch, Branch, ContinuationError, FactoredJacobian, Options, PointObserver, Problem, ProblemError,
-    Silent, TerminationReason,
+    Resumption, Silent, TerminationReason,
 };
 
 /// A sweep that could not start (a failure during the sweep is a termination reason of the
@@ -166,15 +166,114 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
 ) -> Result<Branch, SweepError> {
     let omega_start = off_resonance(hbm, omega_start, omega_end, level)?;
     let guess = hbm.stuck_solution(omega_start, level)?;
-    from_level_ramp(
+    let ramp = |omega: f64| {
+        move |hbm: &mut CondensedHbm<'m>, ramp: &Options| {
+            sweep_level(hbm, omega, 1e-3 * level, level, ramp, &mut Silent)
+        }
+    };
+    let branch = from_level_ramp(
         hbm,
         &guess,
         options,
         |hbm, guess| {
             continue_branch(&mut FrequencySweep { hbm, level }, guess, omega_start, omega_end, options, observer)
         },
-        |hbm, ramp| sweep_level(hbm, omega_start, 1e-3 * level, level, ramp, &mut Silent),
+        ramp(omega_start),
+    )?;
+    let band = (omega_end - omega_start).abs();
+    resumed_past_stops(
+        hbm,
+        branch,
+        omega_end,
+        options,
+        band,
+        |hbm, guess, from, to| {
+            let bridge = within(options, band, from, to);
+            from_level_ramp(
+                hbm,
+                guess,
+                &bridge,
+                |hbm, guess| continue_branch(&mut FrequencySweep { hbm, level }, guess, from, to, &bridge, &mut Silent),
+                ramp(from),
+            )
+        },
+        |hbm, guess, from| {
+            let rest = within(options, band, from, omega_end);
+            continue_branch(&mut FrequencySweep { hbm, level }, guess, from, omega_end, &rest, observer)
+        },
     )
+}
+
+/// The options of a continuation over `from..to`, a part of a band `band` long, with the same
+/// steps in λ as over the band (steps are fractions of the interval continued).
+pub(crate) fn within(options: &Options, band: f64, from: f64, to: f64) -> Options {
+    let scale = band / (to - from).abs().max(f64::MIN_POSITIVE);
+    Options {
+        initial_step: (options.initial_step * scale).min(1.0),
+        min_step: (options.min_step * scale).min(1.0),
+        max_step: (options.max_step * scale).min(1.0),
+        ..options.clone()
+    }
+}
+
+/// Stops resumed per branch, at most.
+const MAX_RESUMPTIONS: usize = 4;
+/// How far beyond a stop the branch is started afresh: these fractions of the largest step,
+/// nearest first (the further, the likelier another branch across a jump).
+const RESTART_DISTANCES: [f64; 3] = [0.0625, 0.25, 1.0];
+/// A bridge arrives at the stop's solution when its last point is within this of it, relative
+/// to its norm: two solutions of one branch at one λ agree to Newton's tolerance, those of two
+/// branches differ at first order.
+const SAME_SOLUTION: f64 = 1e-6;
+
+/// Resume a frequency sweep that stopped before its end, where every step and leap failed (a
+/// corner of a non-smooth branch: the slip instants of the joints jump, and Newton, started
+/// from the tangent's prediction, cycles between slip patterns). The branch is started afresh a
+/// little further on (`bridge(balance, guess, from, to)`: from the last point's solution, else
+/// through the force ramp), followed back to the stop, and where it arrives at the solution the
+/// branch stopped at, the sweep goes on (`forward(balance, guess, from)`) from the bridge's point
+/// next to the stop: the bridge shows that the points on either side of the stop are one branch.
+/// A bridge that arrives elsewhere (another branch, across a jump) or not at all leaves the stop
+/// as it was. Returns the branch, its resumptions in `resumed`.
+pub(crate) fn resumed_past_stops<B: ?Sized>(
+    balance: &mut B,
+    mut branch: Branch,
+    lambda_end: f64,
+    options: &Options,
+    band: f64,
+    mut bridge: impl FnMut(&mut B, &[f64], f64, f64) -> Result<Branch, SweepError>,
+    mut forward: impl FnMut(&mut B, &[f64], f64) -> Result<Branch, ContinuationError>,
+) -> Result<Branch, SweepError> {
+    while branch.resumed.len() < MAX_RESUMPTIONS && matches!(branch.termination, TerminationReason::StepTooSmall { .. })
+    {
+        let Some(last) = branch.points.last() else { break };
+        let (stopped_at, stop) = (last.lambda, last.x.clone());
+        let left = lambda_end - stopped_at;
+        let norm = stop.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut resumed = None;
+        for fraction in RESTART_DISTANCES {
+            let restart = stopped_at + left.signum() * (fraction * options.max_step * band).min(left.abs());
+            let Ok(back) = bridge(balance, &stop, restart, stopped_at) else { continue };
+            branch.calls += back.calls;
+            let arrived = matches!(back.termination, TerminationReason::ReachedEnd)
+                && back.points.last().is_some_and(|p| {
+                    let gap = p.x.iter().zip(&stop).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+                    gap <= SAME_SOLUTION * norm
+                });
+            if arrived && back.points.len() >= 2 {
+                resumed = Some((restart, back.points[back.points.len() - 2].clone()));
+                break;
+            }
+        }
+        let Some((restarted_at, next)) = resumed else { break };
+        let rest = forward(balance, &next.x, next.lambda)?;
+        branch.resumed.push(Resumption { stopped_at, restarted_at });
+        branch.points.extend(rest.points);
+        branch.termination = rest.termination;
+        branch.calls += rest.calls;
+        branch.residual_scale = branch.residual_scale.max(rest.residual_scale);
+    }
+    Ok(branch)
 }
 
 /// A frequency sweep of `balance` from `guess` (`frequency`); when Newton cannot reach its
@@ -257,7 +356,7 @@ mod tests {
             rejected: 0,
             calls: Calls::default(),
         };
-        Branch { points: vec![point], termination, calls: Calls::default(), residual_scale: 1.0 }
+        Branch { points: vec![point], termination, calls: Calls::default(), residual_scale: 1.0, resumed: Vec::new() }
     }
 
     fn failed() -> TerminationReason {
@@ -315,5 +414,131 @@ mod tests {
         let (result, log) = run(true, TerminationReason::MaxPoints);
         assert!(matches!(result.termination, TerminationReason::FirstPointFailed { .. }));
         assert_eq!(log.guesses.len(), 1);
+    }
+
+    fn points(at: &[(f64, f64)]) -> Vec<Point> {
+        at.iter()
+            .map(|&(lambda, x)| Point {
+                x: vec![x],
+                lambda,
+                iterations: 1,
+                residual_norm: 0.0,
+                step: 0.0,
+                rejected: 0,
+                calls: Calls::default(),
+            })
+            .collect()
+    }
+
+    fn stopped() -> TerminationReason {
+        TerminationReason::StepTooSmall {
+            rejection: crate::continuation::Rejection::NoConvergence,
+            lambda: 2.0,
+            residual_norm: 1e-5,
+            attempts: 8,
+            leaps: 7,
+            iterations: 100,
+            last_iterate: None,
+        }
+    }
+
+    fn with(points_at: &[(f64, f64)], termination: TerminationReason) -> Branch {
+        Branch {
+            points: points(points_at),
+            termination,
+            calls: Calls::default(),
+            residual_scale: 1.0,
+            resumed: Vec::new(),
+        }
+    }
+
+    /// Resume a branch stopped at λ = 2 (x = 2) on the way to 10, with bridges made by `bridge`
+    /// (given the restart λ and the call's number) and a rest of the sweep made by `forward`;
+    /// returns the result, the bridges' (guess, from, to) and the rests' (guess, from).
+    #[allow(clippy::type_complexity)]
+    fn resume(
+        bridge: impl Fn(f64, usize) -> Result<Branch, SweepError>,
+        forward: impl Fn(f64) -> Branch,
+    ) -> (Branch, Vec<(f64, f64, f64)>, Vec<(f64, f64)>) {
+        let options = Options { max_step: 0.5, ..Options::default() };
+        let (mut bridges, mut rests) = (Vec::new(), Vec::new());
+        let branch = with(&[(1.0, 1.0), (2.0, 2.0)], stopped());
+        let result = resumed_past_stops(
+            &mut (),
+            branch,
+            10.0,
+            &options,
+            9.0,
+            |_, guess, from, to| {
+                bridges.push((guess[0], from, to));
+                bridge(from, bridges.len())
+            },
+            |_, guess, from| {
+                rests.push((guess[0], from));
+                Ok(forward(from))
+            },
+        )
+        .unwrap();
+        (result, bridges, rests)
+    }
+
+    /// A bridge from `from` back to the stop, arriving at `x_end` there.
+    fn bridge_to(from: f64, x_end: f64) -> Result<Branch, SweepError> {
+        Ok(with(&[(from, from), (2.1, 2.1), (2.0, x_end)], TerminationReason::ReachedEnd))
+    }
+
+    #[test]
+    fn a_stopped_sweep_goes_on_from_the_bridge_point_next_to_the_stop() {
+        let (result, bridges, rests) = resume(
+            |from, _| bridge_to(from, 2.0),
+            |from| with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd),
+        );
+        // The nearest restart, 1/16 of the largest step (0.5 of the band, 9) beyond the stop,
+        // from the stop's solution, followed back to the stop.
+        assert_eq!(bridges, [(2.0, 2.0 + 0.0625 * 0.5 * 9.0, 2.0)]);
+        assert_eq!(rests, [(2.1, 2.1)]);
+        let lambdas: Vec<f64> = result.points.iter().map(|p| p.lambda).collect();
+        assert_eq!(lambdas, [1.0, 2.0, 2.1, 10.0]);
+        assert_eq!(result.termination, TerminationReason::ReachedEnd);
+        assert_eq!(result.resumed, [Resumption { stopped_at: 2.0, restarted_at: 2.28125 }]);
+    }
+
+    #[test]
+    fn a_bridge_that_arrives_at_another_solution_leaves_the_stop() {
+        // Off by 1e-5 of the stop's solution: another branch (one branch agrees to Newton's
+        // tolerance), at every restart distance.
+        let (result, bridges, rests) = resume(|from, _| bridge_to(from, 2.0 * (1.0 + 1e-5)), |_| unreachable!());
+        let restarts: Vec<f64> = bridges.iter().map(|b| b.1).collect();
+        assert_eq!(restarts, [2.28125, 3.125, 6.5]);
+        assert!(rests.is_empty());
+        assert_eq!(result.points.len(), 2);
+        assert_eq!(result.termination, stopped());
+        assert!(result.resumed.is_empty());
+    }
+
+    #[test]
+    fn a_bridge_that_fails_near_the_stop_is_tried_further_on() {
+        let (result, bridges, _) = resume(
+            |from, call| match call {
+                1 => Err(SweepError::Hbm(HbmError::NotEvaluated)),
+                2 => Ok(with(&[(from, from), (2.5, 2.5)], stopped())),
+                _ => bridge_to(from, 2.0),
+            },
+            |from| with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd),
+        );
+        assert_eq!(bridges.len(), 3);
+        assert_eq!(result.resumed, [Resumption { stopped_at: 2.0, restarted_at: 6.5 }]);
+        assert_eq!(result.termination, TerminationReason::ReachedEnd);
+    }
+
+    #[test]
+    fn a_branch_that_keeps_stopping_is_resumed_a_bounded_number_of_times() {
+        // Every rest stops again just after its start.
+        let (result, bridges, rests) =
+            resume(|from, _| bridge_to(from, 2.0), |from| with(&[(from, from), (from + 0.01, 2.0)], stopped()));
+        assert_eq!(rests.len(), MAX_RESUMPTIONS);
+        assert_eq!(bridges.len(), MAX_RESUMPTIONS);
+        assert_eq!(result.resumed.len(), MAX_RESUMPTIONS);
+        assert_eq!(result.termination, stopped());
     }
 }
