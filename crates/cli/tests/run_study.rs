@@ -325,10 +325,14 @@ fn no_plots_writes_the_tables_and_no_image() {
     assert!(status.success());
     let names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    for table in ["frf.csv", "frf.npz", "peaks.csv", "report.html"] {
+    for table in ["frf.csv", "frf.npz", "peaks.csv", "bifurcations.csv", "report.html"] {
         assert!(names.iter().any(|n| n == table), "{table} missing from {names:?}");
     }
     assert!(!names.iter().any(|n| n.ends_with(".png") || n.ends_with(".svg")), "{names:?}");
+    // Without stability the folds and branch points are still sought: none on this friction
+    // response, the header alone.
+    let bifurcations = std::fs::read_to_string(out.join("bifurcations.csv")).unwrap();
+    assert_eq!(bifurcations, "level_N,kind,frequency_Hz,located,floquet_im_rad_per_s,mass_amp_m\n");
 }
 
 /// Resonance peaks of `peaks.csv`: (level N, frequency Hz, displacement FRF m/N), in file order.

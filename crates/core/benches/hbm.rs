@@ -8,12 +8,14 @@ use std::time::Instant;
 use common::{chain_with_joints, table6};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
-use stickslip_core::continuation::{Options, Silent, TerminationReason};
+use stickslip_core::continuation::{
+    Accepted, Options, PointObserver, Problem, Silent, TerminationReason, TestFunctions,
+};
 use stickslip_core::elements::{Contact, Element};
 use stickslip_core::hbm::receptance::HarmonicReceptance;
 use stickslip_core::hbm::{
-    stability_at, stability_by_eigenproblems, sweep_frequency, CondensedHbm, ElementAft, HbmSettings, Hill,
-    HillSettings, Jacobians,
+    folds_and_branch_points, stability_at, stability_by_eigenproblems, sweep_frequency, CondensedHbm, ElementAft,
+    FrequencySweep, HbmSettings, Hill, HillSettings, Jacobians,
 };
 use stickslip_core::model::{relative_direction, ElementSite, NonlinearModel};
 
@@ -43,6 +45,16 @@ fn sweep(model: &NonlinearModel, force_dof: usize, level: f64, band_hz: (f64, f6
         points: branch.points.len(),
         iterations: branch.points.iter().map(|p| p.iterations).sum(),
         complete: branch.termination == TerminationReason::ReachedEnd,
+    }
+}
+
+/// Takes the test functions of folds and branch points of every accepted point.
+#[derive(Default)]
+struct TakeTestFunctions(Vec<Option<TestFunctions>>);
+
+impl<P: Problem + ?Sized> PointObserver<P> for TakeTestFunctions {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, P>) {
+        self.0.push(accepted.test_functions().ok().flatten().cloned());
     }
 }
 
@@ -163,12 +175,14 @@ fn patch_newton_iteration(
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "quick");
-    // Optional filters: `table6`, `paper`, `profile`, `cost`, `contact`, `stability`, `patch`
-    // (default: all).
+    // Optional filters: `table6`, `paper`, `profile`, `cost`, `contact`, `stability`, `folds`,
+    // `patch` (default: all).
     let wanted = |name: &str| {
         let filters: Vec<&String> = args
             .iter()
-            .filter(|a| ["table6", "paper", "profile", "cost", "contact", "stability", "patch"].contains(&a.as_str()))
+            .filter(|a| {
+                ["table6", "paper", "profile", "cost", "contact", "stability", "folds", "patch"].contains(&a.as_str())
+            })
             .collect();
         filters.is_empty() || filters.iter().any(|f| *f == name)
     };
@@ -433,6 +447,46 @@ fn main() {
             "  stability of the {n} points: {:.1} ms, {:.0} % of the sweep",
             total * 1e3,
             100.0 * total / sweep_seconds
+        );
+    }
+    if wanted("folds") {
+        // The test functions of folds and branch points (tangent and determinants) at every
+        // point of a paper-size sweep (2910 N, where the joints slip): the sweep with a silent
+        // observer and with one that asks every accepted point for them, run in turn; then
+        // their search for sign changes along the branch.
+        let paper = chain_with_joints(137, 4, false);
+        let mut force = vec![0.0; 137];
+        force[136] = 1.0;
+        let mut hbm = CondensedHbm::new(&paper, &force, HbmSettings { harmonics: 7, samples: 300 }).unwrap();
+        let (w0, w1) = (TWO_PI * 170.0, TWO_PI * 300.0);
+        let (mut silent, mut asked) = (Vec::new(), Vec::new());
+        let mut taken = (Vec::new(), TakeTestFunctions::default());
+        for _ in 0..runs {
+            let start = Instant::now();
+            std::hint::black_box(sweep_frequency(&mut hbm, 2910.0, w0, w1, &options, &mut Silent).unwrap());
+            silent.push(start.elapsed().as_secs_f64());
+            let mut tests = TakeTestFunctions::default();
+            let start = Instant::now();
+            let branch = sweep_frequency(&mut hbm, 2910.0, w0, w1, &options, &mut tests).unwrap();
+            asked.push(start.elapsed().as_secs_f64());
+            taken = (branch.points, tests);
+        }
+        let (points, tests) = taken;
+        let start = Instant::now();
+        let found =
+            folds_and_branch_points(&mut FrequencySweep { hbm: &mut hbm, level: 2910.0 }, &points, &tests.0, 1e-10);
+        let search = start.elapsed().as_secs_f64();
+        let (silent, asked) = (median(silent), median(asked));
+        println!(
+            "137 DOFs, q = 4, 2910 N: sweep {:.2} ms, with the test functions of its {} points {:.2} ms \
+             (+{:.1} %, {:.1} us/point); their search {:.3} ms, {} found",
+            silent * 1e3,
+            points.len(),
+            asked * 1e3,
+            100.0 * (asked / silent - 1.0),
+            (asked - silent) * 1e6 / points.len() as f64,
+            search * 1e3,
+            found.len()
         );
     }
     if wanted("contact") {

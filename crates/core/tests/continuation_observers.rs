@@ -1,12 +1,14 @@
 //! What the continuation hands its observers at each accepted point ([`Accepted`]): the
-//! problem as the converged evaluation left it, and the Jacobian there on demand. Checked
-//! against evaluating each point again after the branch, the way results were made before:
-//! the point's results, its stability and its Jacobian must be the same numbers.
+//! problem as the converged evaluation left it, the Jacobian there on demand and the test
+//! functions of folds and branch points. Checked against evaluating each point again after the
+//! branch, the way results were made before: the point's results, its stability and its
+//! Jacobian must be the same numbers, the determinant that of that Jacobian, and the branch the
+//! same as a silent observer's.
 #[path = "../benches/common/mod.rs"]
 mod common;
 
 use faer::Mat;
-use stickslip_core::continuation::{Accepted, Options, PointObserver, Silent, TerminationReason};
+use stickslip_core::continuation::{Accepted, Options, PointObserver, Silent, TerminationReason, TestFunctions};
 use stickslip_core::hbm::{
     stability_at, stability_at_last_evaluation, sweep_frequency, CondensedHbm, FrequencySweep, HbmSettings, Hill,
     HillSettings, Jacobians, Stability,
@@ -23,6 +25,7 @@ struct Taken<'h> {
     results: Vec<PointResult>,
     stabilities: Vec<Stability>,
     jacobians: Vec<(Mat<f64>, Vec<f64>)>,
+    tests: Vec<TestFunctions>,
     fractions: Vec<f64>,
 }
 
@@ -32,6 +35,7 @@ impl<'a, 'm> PointObserver<FrequencySweep<'a, 'm>> for Taken<'_> {
         // The Jacobian first: it is completed from the converged evaluation.
         let (dx, dl) = accepted.jacobian().unwrap().expect("a dense Jacobian");
         self.jacobians.push((dx.to_owned(), dl.to_vec()));
+        self.tests.push(accepted.test_functions().unwrap().expect("a regular point").clone());
         let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
         let hbm = &mut *accepted.problem().hbm;
         self.results.push(point_result(hbm, &x, &self.outputs).unwrap());
@@ -52,11 +56,15 @@ fn check(model: &NonlinearModel, force: &[f64], level: f64, band_hz: (f64, f64))
         results: Vec::new(),
         stabilities: Vec::new(),
         jacobians: Vec::new(),
+        tests: Vec::new(),
         fractions: Vec::new(),
     };
     let (w0, w1) = (TWO_PI * band_hz.0, TWO_PI * band_hz.1);
     let branch = sweep_frequency(&mut hbm, level, w0, w1, &Options::default(), &mut taken).unwrap();
     assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    // What the observer asked for does not change the path.
+    let silent = sweep_frequency(&mut hbm, level, w0, w1, &Options::default(), &mut Silent).unwrap();
+    assert_eq!(silent.points, branch.points);
     assert_eq!(taken.results.len(), branch.points.len());
     assert!(taken.fractions.windows(2).all(|f| f[0] <= f[1]) && taken.fractions.last() == Some(&1.0));
 
@@ -87,6 +95,15 @@ fn check(model: &NonlinearModel, force: &[f64], level: f64, band_hz: (f64, f64))
         let (cdx, cdl) = &taken.jacobians[i];
         assert!(dx == *cdx, "point {i}: ∂R/∂x differs");
         assert_eq!(&dl, cdl, "point {i}: ∂R/∂Ω differs");
+
+        // The determinant of the test functions, from the bordered LU (Eq. 1 of
+        // `continuation::singular`), against that of the Jacobian, scaled: two LUs of
+        // different matrices, so to round-off of their logarithms (measured 7e-16).
+        let t = &taken.tests[i];
+        let direct = dx.determinant();
+        let scaled_ln = direct.abs().ln() + dim as f64 * (t.scales.unknowns / t.scales.residual).ln();
+        assert_eq!(t.jacobian.sign, direct.signum(), "point {i}");
+        assert!((t.jacobian.ln_abs - scaled_ln).abs() <= 1e-12 * scaled_ln.abs().max(1.0), "point {i}");
 
         // Stability from the completed joints' Jacobian against one evaluated again: the same
         // matrix, so the same exponents bit for bit.

@@ -1,14 +1,17 @@
-//! Hill's method on a Duffing oscillator: the middle branch between the folds is unstable, and
-//! the Floquet multipliers equal those of the monodromy matrix integrated in time.
+//! Hill's method on a Duffing oscillator: the middle branch between the folds is unstable, the
+//! Floquet multipliers equal those of the monodromy matrix integrated in time, and the folds
+//! found from the continuation's tangent are where the leading exponent crosses zero.
 mod duffing_common;
 
 use duffing_common::{duffing, C, F, K, K3, M};
-use faer::{c64, Mat};
-use stickslip_core::continuation::{zero_along, Options, Silent, TerminationReason};
+use faer::c64;
+use stickslip_core::continuation::{
+    zero_along, Accepted, Options, PointObserver, Problem, Silent, TerminationReason, TestFunctions,
+};
 use stickslip_core::hbm::fourier::{cos_index, sin_index};
 use stickslip_core::hbm::{
-    bifurcations, stability_at, sweep_frequency, BifurcationKind, CondensedHbm, FrequencySweep, HbmSettings, Hill,
-    HillSettings, Jacobians,
+    floquet_bifurcations, folds_and_branch_points, stability_at, sweep_frequency, BifurcationKind, CondensedHbm,
+    FrequencySweep, HbmSettings, Hill, HillSettings,
 };
 
 const HARMONICS: usize = 7;
@@ -99,40 +102,53 @@ fn the_middle_branch_is_unstable_and_hill_matches_the_monodromy_matrix() {
     assert!(checked[0] >= 3 && checked[1] >= 1, "points compared (stable, unstable): {checked:?}");
 }
 
+/// Keeps the test functions of every accepted point.
+#[derive(Default)]
+struct Tests(Vec<Option<TestFunctions>>);
+
+impl<P: Problem + ?Sized> PointObserver<P> for Tests {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, P>) {
+        self.0.push(accepted.test_functions().unwrap().cloned());
+    }
+}
+
 #[test]
-fn the_leading_exponent_crosses_zero_at_each_fold() {
+fn the_folds_from_the_tangent_are_where_the_leading_exponent_crosses_zero() {
     let model = duffing();
     let settings = HbmSettings { harmonics: HARMONICS, samples: 64 };
     let mut hbm = CondensedHbm::new(&model, &[1.0], settings).unwrap();
-    let branch = sweep_frequency(&mut hbm, F, 50.0, 250.0, &Options::default(), &mut Silent).unwrap();
-    let hill = Hill::new(hbm.receptance(), HillSettings::for_band(HARMONICS, 250.0)).unwrap();
+    let mut tests = Tests::default();
+    let branch = sweep_frequency(&mut hbm, F, 50.0, 250.0, &Options::default(), &mut tests).unwrap();
     let points = &branch.points;
-    let stabilities: Vec<_> = points.iter().map(|p| stability_at(&mut hbm, &hill, &p.x, p.lambda).unwrap()).collect();
-    let found = bifurcations(&mut hbm, &hill, F, points, &stabilities, 1e-10);
+    // Without any stability: the tangent's Ω-component changes sign at each fold.
+    let found = folds_and_branch_points(&mut FrequencySweep { hbm: &mut hbm, level: F }, points, &tests.0, 1e-10);
     let kinds: Vec<_> = found.iter().map(|b| b.kind).collect();
     assert_eq!(kinds, [BifurcationKind::Fold, BifurcationKind::Fold], "{found:?}");
-    // Each fold independently: where the balance's own Jacobian ∂R/∂x (flexibility form, not
-    // Hill's matrix) is singular, located along the same segment of the branch.
+    // Hill's method, independently: the leading exponent crosses zero at each, located along
+    // the same segment of the branch.
+    let hill = Hill::new(hbm.receptance(), HillSettings::for_band(HARMONICS, 250.0)).unwrap();
     for b in &found {
         assert!(b.located);
         let pair = [&points[b.after_point], &points[b.after_point + 1]];
-        let singular = zero_along(&mut FrequencySweep { hbm: &mut hbm, level: F }, pair, 1e-12, |p, x, w| {
-            let n = x.len();
-            let (mut r, mut jac) = (vec![0.0; n], Mat::zeros(n, n));
-            let jacobians = Jacobians { dx: jac.as_mut(), domega: None, dlevel: None };
-            p.hbm.evaluate(x, w, F, &mut r, Some(jacobians)).unwrap();
-            Ok(jac.determinant())
+        let by_hill = zero_along(&mut FrequencySweep { hbm: &mut hbm, level: F }, pair, 1e-10, |p, x, w| {
+            Ok(stability_at(p.hbm, &hill, x, w).unwrap().leading().re)
         })
         .unwrap();
-        // Both are located to round-off on their own measure (1e-10 and 1e-12 of the chord):
-        // measured 2e-16 apart, asserted to 1e-9 (1e-6 of the fold frequency is the criterion).
-        let relative = (b.omega - singular.lambda).abs() / singular.lambda;
+        // Both are located to round-off on their own measure (1e-10 of the chord): measured
+        // 4e-16 and 0 apart, asserted to 1e-9 (1e-6 of the fold frequency is the criterion). Hill's
+        // matrix at s = 0 is the balance's Jacobian in dynamic-stiffness form, and this
+        // oscillator has no mode left out of it: the two are singular together.
+        let relative = (b.omega - by_hill.lambda).abs() / by_hill.lambda;
         assert!(
             relative < 1e-9,
-            "fold at {} rad/s by Hill, {} by det ∂R/∂x ({relative:.1e})",
+            "fold at {} rad/s from the tangent, {} by Hill ({relative:.1e})",
             b.omega,
-            singular.lambda
+            by_hill.lambda
         );
-        assert!(b.exponent.re.abs() < 1e-6 * b.omega && b.exponent.im.abs() < 1e-6 * b.omega, "{}", b.exponent);
+        let exponent = stability_at(&mut hbm, &hill, &b.x, b.omega).unwrap().leading();
+        assert!(exponent.norm() < 1e-6 * b.omega, "{exponent}");
     }
+    // With the stability known, the exponents add no bifurcation (their crossings are real).
+    let stabilities: Vec<_> = points.iter().map(|p| stability_at(&mut hbm, &hill, &p.x, p.lambda).unwrap()).collect();
+    assert!(floquet_bifurcations(&mut hbm, &hill, F, points, &stabilities, 1e-10).is_empty());
 }

@@ -10,15 +10,16 @@ use std::path::PathBuf;
 use faer::MatMut;
 use stickslip_core::continuation::{
     Accepted, Bracket, Branch, FactoredJacobian, Observer, Options, PointObserver, Predictor, Problem, ProblemError,
-    Rejection, Scales, Silent, TerminationReason,
+    Rejection, Scales, Silent, TerminationReason, TestFunctions,
 };
 use stickslip_core::hbm::bifurcation::is_stable;
 use stickslip_core::hbm::dlft::{self, DlftFrequencySweep, DlftHbm};
 use stickslip_core::hbm::receptance::Outputs;
 use stickslip_core::hbm::{
-    bifurcations, nonlinear_mode, stability_at_last_evaluation, sweep_frequency, sweep_level, Backbone,
-    BranchStabilityError, CondensedHbm, FrequencySweep, HbmError, HbmSettings as CoreHbmSettings, Hill, HillSettings,
-    NegativeDamping, NonlinearModeError, NonlinearModeSettings, Stability, SweepError,
+    floquet_bifurcations, folds_and_branch_points, nonlinear_mode, stability_at_last_evaluation, sweep_frequency,
+    sweep_level, Backbone, BranchStabilityError, CondensedHbm, FrequencySweep, HbmError,
+    HbmSettings as CoreHbmSettings, Hill, HillSettings, NegativeDamping, NonlinearModeError, NonlinearModeSettings,
+    Stability, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{
@@ -376,6 +377,7 @@ impl<'a> LevelSweeper<'a> {
             progress: observer,
             points: Vec::new(),
             stabilities: Vec::new(),
+            tests: Vec::new(),
             error: None,
         };
         let (start, end) = (TWO_PI * study.sweep.start_hz, TWO_PI * study.sweep.end_hz);
@@ -383,27 +385,30 @@ impl<'a> LevelSweeper<'a> {
         if let Some(error) = recorder.error {
             return Err(error);
         }
-        let PointRecorder { points, stabilities, .. } = recorder;
+        let PointRecorder { points, stabilities, tests, .. } = recorder;
         let peaks = locate_peaks(&mut hbm, &branch, level, selectors, &points);
-        let bifurcations = match (hill, &mut hbm) {
-            (Some(hill), Balance::Penalty(hbm)) => {
-                bifurcations(hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE)
-                    .into_iter()
-                    .map(|b| -> Result<BifurcationRecord, SweepError> {
-                        let result = evaluate_point(hbm, &b.x, b.omega, level, selectors)?;
-                        Ok(BifurcationRecord {
-                            level_n: level,
-                            kind: b.kind.name().to_string(),
-                            frequency_hz: b.omega / TWO_PI,
-                            amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
-                            exponent_im: b.exponent.im,
-                            located: b.located,
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?
-            }
-            _ => Vec::new(),
-        };
+        // Folds and branch points at every sweep; period doublings and Neimark-Sacker
+        // bifurcations where the stability is known.
+        let mut found =
+            folds_and_branch_points(&mut hbm.frequency_problem(level), &branch.points, &tests, BIFURCATION_TOLERANCE);
+        if let (Some(hill), Balance::Penalty(hbm)) = (hill, &mut hbm) {
+            found.extend(floquet_bifurcations(hbm, hill, level, &branch.points, &stabilities, BIFURCATION_TOLERANCE));
+            found.sort_by_key(|b| b.after_point);
+        }
+        let bifurcations = found
+            .into_iter()
+            .map(|b| -> Result<BifurcationRecord, SweepError> {
+                let result = hbm.evaluate_point(&b.x, b.omega, level, selectors)?;
+                Ok(BifurcationRecord {
+                    level_n: level,
+                    kind: b.kind.name().to_string(),
+                    frequency_hz: b.omega / TWO_PI,
+                    amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
+                    exponent_im: b.exponent.map_or(0.0, |e| e.im),
+                    located: b.located,
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let start_note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
             format!(
                 "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
@@ -441,10 +446,11 @@ impl<'a> LevelSweeper<'a> {
     }
 }
 
-/// The record of each point of a level (and its stability, when asked) made as the
-/// continuation accepts it. For the penalty balance from the evaluation that converged there
-/// (core [`point_result`], [`stability_at_last_evaluation`]): nothing is evaluated again after
-/// the branch. Progress goes on to the caller's observer.
+/// The record of each point of a level (its stability, when asked, and the test functions of
+/// folds and branch points) made as the continuation accepts it. For the penalty balance from
+/// the evaluation that converged there (core [`point_result`],
+/// [`stability_at_last_evaluation`]): nothing is evaluated again after the branch. Progress
+/// goes on to the caller's observer.
 struct PointRecorder<'s, O: ?Sized> {
     study: &'s Study,
     hill: Option<&'s Hill>,
@@ -453,6 +459,8 @@ struct PointRecorder<'s, O: ?Sized> {
     progress: &'s mut O,
     points: Vec<PointRecord>,
     stabilities: Vec<Stability>,
+    /// Per point, the continuation's test functions ([`Accepted::test_functions`]).
+    tests: Vec<Option<TestFunctions>>,
     /// The first failure to post-process a point (the branch runs on; the level reports it).
     error: Option<SweepError>,
 }
@@ -473,6 +481,10 @@ impl<O: Observer + ?Sized> PointRecorder<'_, O> {
         let residual = accepted.point().residual_norm / accepted.residual_scale();
         let (iterations, index) = (accepted.point().iterations, self.points.len());
         let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
+        // Before the problem is handed out: the Jacobian is completed from the converged
+        // evaluation. A point where they cannot be made has none (the folds and branch points
+        // on its two sides are not sought).
+        self.tests.push(accepted.test_functions().ok().flatten().cloned());
         match results(accepted.problem(), &x, omega) {
             Ok((result, stability)) => {
                 let mut point = record(&result, iterations, residual, self.study.output_options.time_data.keeps(index));

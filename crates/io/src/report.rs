@@ -41,8 +41,10 @@ pub struct ReportData {
     pub levels: Vec<LevelSummary>,
     /// Largest FRF amplitude per level and output (see [`peaks`]).
     pub peaks: Vec<Peak>,
-    /// Was the stability of every point computed? Then the bifurcations found, all levels.
+    /// Was the stability of every point computed?
     pub stability: bool,
+    /// The bifurcations found, all levels: folds and branch points, and with the stability
+    /// period doublings and Neimark-Sacker bifurcations.
     pub bifurcations: Vec<BifurcationRecord>,
     /// Files written by the run; the PNG and SVG ones are embedded, the others listed.
     pub files: Vec<PathBuf>,
@@ -358,9 +360,7 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
     let has = |k: &[Kind]| figures.iter().any(|f| k.contains(&f.kind));
     h.push_str("<nav>");
     let mut nav = vec![("model", "Model"), ("sweep", "Sweep"), ("frf", "FRFs"), ("peaks", "Peaks")];
-    if data.stability {
-        nav.push(("bifurcations", "Stability"));
-    }
+    nav.push(("bifurcations", if data.stability { "Stability" } else { "Bifurcations" }));
     if has(&[Kind::Harmonics]) {
         nav.push(("harmonics", "Harmonics"));
     }
@@ -385,9 +385,7 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
     h.push_str("</section>\n");
 
     peak_section(&mut h, data);
-    if data.stability {
-        bifurcation_section(&mut h, data);
-    }
+    bifurcation_section(&mut h, data);
 
     let level_name = |i: Option<usize>| match i.and_then(|i| data.levels.get(i)) {
         Some(l) => format!("{} N", number(l.level_n)),
@@ -543,15 +541,27 @@ fn peak_section(h: &mut String, data: &ReportData) {
 }
 
 fn bifurcation_section(h: &mut String, data: &ReportData) {
-    h.push_str("<section id=\"bifurcations\">\n<h2>Stability and bifurcations</h2>\n");
-    h.push_str(
-        "<p>Each point's stability comes from its Floquet exponents by Hill's method (frf.csv: <code>stable</code>, \
-         <code>floquet_re_per_s</code>, <code>floquet_im_rad_per_s</code>); unstable branches are dashed in the FRF \
-         plots. Where an exponent crosses the imaginary axis the branch bifurcates: LP fold, BP branch point, PD period \
-         doubling, NS Neimark-Sacker (<code>bifurcations.csv</code>).</p>\n",
-    );
+    let singular = "Folds (LP) and branch points (BP) come from the continuation's tangent and determinants at every \
+                    point";
+    if data.stability {
+        h.push_str("<section id=\"bifurcations\">\n<h2>Stability and bifurcations</h2>\n");
+        let _ = writeln!(
+            h,
+            "<p>Each point's stability comes from its Floquet exponents by Hill's method (frf.csv: <code>stable</code>, \
+             <code>floquet_re_per_s</code>, <code>floquet_im_rad_per_s</code>); unstable branches are dashed in the FRF \
+             plots. {singular}; period doublings (PD) and Neimark-Sacker bifurcations (NS) from a complex pair of \
+             exponents crossing the imaginary axis (<code>bifurcations.csv</code>).</p>"
+        );
+    } else {
+        h.push_str("<section id=\"bifurcations\">\n<h2>Bifurcations</h2>\n");
+        let _ = writeln!(
+            h,
+            "<p>{singular} (<code>bifurcations.csv</code>). <code>stability = true</code> adds each point's \
+             stability by Hill's method, and the period doublings and Neimark-Sacker bifurcations.</p>"
+        );
+    }
     if data.bifurcations.is_empty() {
-        h.push_str("<p>Every point is stable: no bifurcation.</p>\n</section>\n");
+        h.push_str("<p>No bifurcation on any branch.</p>\n</section>\n");
         return;
     }
     h.push_str("<table>\n<tr><th>level (N)</th><th>kind</th><th>frequency (Hz)</th><th>|X<sub>1</sub>| at the outputs (m)</th></tr>\n");
@@ -723,6 +733,32 @@ mod tests {
         // The check script and the attributes it fills.
         assert!(html.contains("data-figures=\"unchecked\" data-errors=\"unchecked\""));
         assert!(html.contains("naturalWidth > 0") && html.contains("window.onerror"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn the_folds_are_tabled_with_or_without_the_stability() {
+        let dir = scratch("bifurcations");
+        let mut data = data(&dir, &[]);
+        let fold = BifurcationRecord {
+            level_n: 100.0,
+            kind: "fold".into(),
+            frequency_hz: 241.25,
+            amplitudes: vec![("mass".into(), 2.5e-4)],
+            exponent_im: 0.0,
+            located: true,
+        };
+        let html = render(&data).unwrap();
+        assert!(html.contains("<a href=\"#bifurcations\">Bifurcations</a>") && html.contains("<h2>Bifurcations</h2>"));
+        assert!(html.contains("No bifurcation on any branch."));
+        data.bifurcations = vec![fold];
+        let html = render(&data).unwrap();
+        assert!(html.contains("<td>fold</td><td class=\"num\">241.2500</td><td>mass: 2.500e-4</td>"));
+        assert!(!html.contains("Floquet exponents by Hill's method"));
+        data.stability = true;
+        let html = render(&data).unwrap();
+        assert!(html.contains("<h2>Stability and bifurcations</h2>") && html.contains("<td>fold</td>"));
+        assert!(html.contains("Floquet exponents by Hill's method"));
         let _ = std::fs::remove_dir_all(&dir);
     }
 

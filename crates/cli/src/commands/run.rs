@@ -174,7 +174,7 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let backbone = backbone.map(|b| b.map(|(files, _)| files));
     let points: usize = levels.iter().map(|l| l.points.len()).sum();
     eprintln!(
-        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, peaks.csv{}, points/)",
+        "{points} points over {} level(s), {start_hz}-{end_hz} Hz, in {:.3} s; wrote {} files to {} (frf.csv, frf.npz, peaks.csv, bifurcations.csv{}, points/)",
         levels.len(),
         elapsed.as_secs_f64(),
         files.len(),

@@ -346,13 +346,26 @@ pub fn zero_along<P: Problem>(
         let s = if fa != fb { (a.0 * fb - b.0 * fa) / (fb - fa) } else { 0.5 * (a.0 + b.0) };
         // Keep the trial strictly inside the bracket, off its ends by a little of its width.
         let width = b.0 - a.0;
-        let s = s.clamp(a.0 + 0.01 * width, b.0 - 0.01 * width);
-        for i in 0..=n {
-            let w = (s - a.0) / width;
-            z[i] = (1.0 - w) * a.1[i] + w * b.1[i];
+        let mut s = s.clamp(a.0 + 0.01 * width, b.0 - 0.01 * width);
+        let mut solved = false;
+        // Near a branch point the corrector's bordered matrix is nearly singular on every
+        // hyperplane (∂R/∂z has rank n − 1 there) and Newton cannot resolve the branch from the
+        // other one crossing it, which is as near: a trial that regula falsi puts there is
+        // replaced by one an eighth of the bracket or more away from it, towards its farther end.
+        let farther = if s - a.0 > b.0 - s { a.0 } else { b.0 };
+        for trial in [s, s + 0.25 * (farther - s)] {
+            s = trial;
+            for i in 0..=n {
+                let w = (s - a.0) / width;
+                z[i] = (1.0 - w) * a.1[i] + w * b.1[i];
+            }
+            solves += 1;
+            solved = path.solve(problem, s, &mut z)?;
+            if solved {
+                break;
+            }
         }
-        solves += 1;
-        if !path.solve(problem, s, &mut z)? {
+        if !solved {
             return Err(ProblemError::new(format!("the branch could not be solved at {s} of the bracket")));
         }
         let fs = value(problem, &z)?;

@@ -8,6 +8,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::{Mat, MatMut, MatRef, Par};
 
+use super::singular::Determinant;
 use super::{Problem, ProblemError};
 
 /// Workspace for the corrector: Jacobian buffers, LU factors and right-hand side.
@@ -22,6 +23,10 @@ pub(super) struct Workspace {
     pub rhs: Vec<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
+    /// Row transpositions of the last dense factorisation (the sign of its permutation).
+    transpositions: usize,
+    /// Dense: `matrix` holds the Jacobian of the last evaluation, not yet factored.
+    holds_jacobian: bool,
     scratch: MemBuffer,
     /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
     factored: bool,
@@ -57,6 +62,8 @@ impl Workspace {
             rhs: vec![0.0; n + 1],
             perm: vec![0; n + 1],
             perm_inv: vec![0; n + 1],
+            transpositions: 0,
+            holds_jacobian: false,
             scratch: MemBuffer::new(req),
         }
     }
@@ -72,6 +79,7 @@ impl Workspace {
     ) -> Result<(), ProblemError> {
         let n = self.n;
         self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
+        self.holds_jacobian = false;
         if !with_jacobian {
             return problem.evaluate(x, lambda, &mut self.residual, None);
         }
@@ -82,7 +90,14 @@ impl Workspace {
         }
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
-        problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))
+        problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))?;
+        self.holds_jacobian = true;
+        Ok(())
+    }
+
+    /// Does the (dense) matrix hold the Jacobian of the last evaluation, not yet factored?
+    pub fn holds_jacobian(&self) -> bool {
+        self.holds_jacobian
     }
 
     /// Does the problem factor `∂R/∂x` itself (no dense matrix here)?
@@ -103,7 +118,10 @@ impl Workspace {
         self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
-        problem.complete_jacobian((jx, &mut self.dr_dlambda))
+        self.holds_jacobian = false;
+        problem.complete_jacobian((jx, &mut self.dr_dlambda))?;
+        self.holds_jacobian = true;
+        Ok(())
     }
 
     /// Solve the bordered system of Eq. 32 in scaled variables,
@@ -177,11 +195,29 @@ impl Workspace {
         self.factor_and_solve(n)
     }
 
+    /// The determinant of the bordered matrix of the last [`Self::solve_bordered`], from its
+    /// LU factors `P A = L U` (L unit lower triangular): the product of U's diagonal, negated
+    /// for an odd number of row transpositions. `None` for a problem that factors its own
+    /// Jacobian (the bordered matrix is never formed).
+    pub fn bordered_determinant(&self) -> Option<Determinant> {
+        if self.factored {
+            return None;
+        }
+        let mut determinant = Determinant { sign: if self.transpositions & 1 == 0 { 1.0 } else { -1.0 }, ln_abs: 0.0 };
+        for i in 0..=self.n {
+            let pivot = self.matrix[(i, i)];
+            determinant.sign *= if pivot == 0.0 { 0.0 } else { pivot.signum() };
+            determinant.ln_abs += pivot.abs().ln();
+        }
+        Some(determinant)
+    }
+
     fn factor_and_solve(&mut self, size: usize) -> bool {
+        self.holds_jacobian = false;
         let par = Par::Seq;
         let mut a = self.matrix.as_mut().submatrix_mut(0, 0, size, size);
         let stack = MemStack::new(&mut self.scratch);
-        let (_, perm) = factor::lu_in_place(
+        let (info, perm) = factor::lu_in_place(
             a.as_mut(),
             &mut self.perm[..size],
             &mut self.perm_inv[..size],
@@ -189,6 +225,7 @@ impl Workspace {
             stack,
             Default::default(),
         );
+        self.transpositions = info.transposition_count;
         let lu = a.as_ref();
         let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs[..size], size, 1);
         solve::solve_in_place(lu, lu, perm, rhs, par, MemStack::new(&mut self.scratch));

@@ -118,9 +118,11 @@
 mod extremum;
 mod linear;
 mod run;
+mod singular;
 
 pub use extremum::{maximise_along, zero_along, Bracket, Extremum};
 pub use run::continue_branch;
+pub use singular::{singular_points, Determinant, SingularKind, SingularPoint, TestFunctions, VariableScales};
 
 use faer::{MatMut, MatRef};
 use linear::Workspace;
@@ -491,7 +493,8 @@ pub type JacobianAt<'a> = (MatRef<'a, f64>, &'a [f64]);
 /// An accepted point as the continuation hands it to a [`PointObserver`]: the point, and the
 /// problem whose last evaluation was the residual at this very point (so per-point data, e.g.
 /// the element forces of a harmonic balance, can be read from it as they stand), with the
-/// Jacobian there on demand ([`Self::jacobian`]).
+/// Jacobian there on demand ([`Self::jacobian`]) and the test functions of folds and branch
+/// points ([`Self::test_functions`]).
 pub struct Accepted<'a, P: ?Sized> {
     point: &'a Point,
     fraction_done: f64,
@@ -501,6 +504,18 @@ pub struct Accepted<'a, P: ?Sized> {
     /// The problem's last evaluation is still the residual alone at the point, which it can
     /// complete to a Jacobian ([`Problem::complete_jacobian`]).
     completable: bool,
+    /// The workspace holds `∂R/∂x` and `∂R/∂λ` at the point, not yet factored.
+    jacobian_held: bool,
+    /// The step that reached the point, in the scaled variables of `scales` (at the first
+    /// point, the tangent there or the direction towards `λ_end`): the tangent's orientation.
+    direction: &'a [f64],
+    scales: VariableScales,
+    /// The continuation factored the bordered matrix `B(direction)` at the point itself (for
+    /// its tangent): the unit tangent, `|w|`, `det B(direction)` (Eq. 2 of `singular`)
+    /// and the scaled variables they are in.
+    tangent_factors: Option<(&'a [f64], f64, Determinant, VariableScales)>,
+    /// The test functions, once asked for (`Some(None)`: there are none).
+    test_functions: Option<Option<TestFunctions>>,
     /// Calls made here (the Jacobian), added to the branch's.
     calls: Calls,
 }
@@ -537,16 +552,46 @@ impl<'a, P: Problem + ?Sized> Accepted<'a, P> {
         if self.workspace.factors() {
             return Ok(None);
         }
-        if self.completable {
-            self.calls += Calls { residuals: 0, jacobians: 1, factorizations: 0 };
-            self.workspace.complete(self.problem)?;
-        } else {
-            self.calls += Calls { residuals: 1, jacobians: 1, factorizations: 0 };
-            self.workspace.evaluate(self.problem, &self.point.x, self.point.lambda, true)?;
+        if !self.jacobian_held {
+            if self.completable {
+                self.calls += Calls { residuals: 0, jacobians: 1, factorizations: 0 };
+                self.workspace.complete(self.problem)?;
+            } else {
+                self.calls += Calls { residuals: 1, jacobians: 1, factorizations: 0 };
+                self.workspace.evaluate(self.problem, &self.point.x, self.point.lambda, true)?;
+            }
+            // The problem's last evaluation is now the point's, with its Jacobian.
+            self.completable = false;
+            self.jacobian_held = true;
         }
-        // The problem's last evaluation is now the point's, with its Jacobian.
-        self.completable = false;
         Ok(Some(self.workspace.jacobian()))
+    }
+
+    /// The test functions of folds and branch points at the point ([`TestFunctions`]: the unit
+    /// tangent oriented along the branch, `det ∂R/∂x` and the bordered determinant): from the
+    /// continuation's own factorisation where it made one at the point (the first point, and
+    /// every point with [`Predictor::Tangent`]), else from the Jacobian there
+    /// ([`Self::jacobian`]) and one LU of size n + 1, which the Jacobian does not survive (a
+    /// later [`Self::jacobian`] evaluates it again: ask for it first). The path of the
+    /// continuation does not depend on it. `None` for a problem that factors its own
+    /// Jacobian, or where the bordered matrix is singular.
+    pub fn test_functions(&mut self) -> Result<Option<&TestFunctions>, ProblemError> {
+        if self.test_functions.is_none() {
+            let found = match self.tangent_factors.take() {
+                Some((tangent, w_norm, determinant, scales)) => {
+                    Some(TestFunctions::new(tangent.to_vec(), w_norm, determinant, scales))
+                }
+                None if self.workspace.factors() => None,
+                None => {
+                    self.jacobian()?;
+                    self.calls += Calls { residuals: 0, jacobians: 0, factorizations: 1 };
+                    self.jacobian_held = false;
+                    singular::test_functions_at(self.workspace, self.problem, self.scales, self.direction)
+                }
+            };
+            self.test_functions = Some(found);
+        }
+        Ok(self.test_functions.as_ref().and_then(Option::as_ref))
     }
 }
 

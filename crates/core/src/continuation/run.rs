@@ -3,8 +3,8 @@
 
 use super::linear::Workspace;
 use super::{
-    Accepted, Branch, Calls, ContinuationError, Options, Point, PointObserver, Predictor, Problem, ProblemError,
-    Rejection, TerminationReason,
+    Accepted, Branch, Calls, ContinuationError, Determinant, Options, Point, PointObserver, Predictor, Problem,
+    ProblemError, Rejection, TerminationReason, VariableScales,
 };
 
 /// Follow the solution curve of `problem` from `λ_start` (solved from `x_guess`) to `λ_end`.
@@ -80,6 +80,10 @@ impl Scaling {
             *o = xi / self.x;
         }
         out[n] = lambda / self.lambda;
+    }
+
+    fn variables(&self) -> VariableScales {
+        VariableScales { unknowns: self.x, parameter: self.lambda, residual: self.residual }
     }
 
     /// A physical direction `[dx, dλ]` in scaled variables, in place.
@@ -199,6 +203,14 @@ struct Runner<'a, P: ?Sized> {
     /// the first point), for the angle check; and the tangent at the last point.
     previous_direction: Vec<f64>,
     tangent: Vec<f64>,
+    /// The step that reached the point handed to the observer, scaled as it was taken: the
+    /// orientation of the tangent there ([`Accepted::test_functions`]).
+    step_direction: Vec<f64>,
+    /// The last tangent computed ([`Self::tangent_at_last_point`]), scaled, and from its
+    /// factorisation `|w|`, the determinant of the bordered matrix and the scales: the test
+    /// functions at that point for nothing more.
+    last_tangent: Vec<f64>,
+    last_tangent_factors: Option<(f64, Determinant, VariableScales)>,
     /// The last error at a trial iterate, and where.
     trial_error: Option<(f64, ProblemError)>,
     /// The last evaluation was of the residual alone.
@@ -231,7 +243,10 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             reference: zeros.clone(),
             x_phys: vec![0.0; n],
             previous_direction: zeros.clone(),
-            tangent: zeros,
+            tangent: zeros.clone(),
+            step_direction: zeros.clone(),
+            last_tangent: zeros,
+            last_tangent_factors: None,
             trial_error: None,
             last_residual_only: false,
         }
@@ -270,9 +285,14 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         // Initial tangent, oriented towards λ_end (a pure λ step if the start is singular).
         self.reference.iter_mut().for_each(|v| *v = 0.0);
         self.reference[n] = self.direction;
-        if !self.tangent_at_last_point() {
+        let first_tangent = self.tangent_at_last_point();
+        if !first_tangent {
             self.tangent.copy_from_slice(&self.reference);
         }
+        // The first point's test functions in the scaled variables of its tangent, before s_x
+        // is set below.
+        self.step_direction.copy_from_slice(&self.tangent);
+        let first_scales = self.scale.variables();
         self.scale.direction_to_physical(&mut self.tangent);
         self.previous_direction.copy_from_slice(&self.tangent);
         if !self.scale.x_fixed {
@@ -282,7 +302,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             let across_band = if dx_dlambda.is_finite() { dx_dlambda * self.scale.lambda } else { 0.0 };
             self.scale.x = positive_or_one(norm(&first.x).max(across_band));
         }
-        self.hand_over(observer, &first, 0.0);
+        self.hand_over(observer, &first, 0.0, first_scales, first_tangent);
         points.push(first);
 
         let mut control = StepControl {
@@ -368,7 +388,11 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
                     Outcome::Converged { iterations, residual_norm } => {
                         let step = distance(&self.z, &self.z_last);
                         let point = self.make_point(boundary, iterations, residual_norm, step, control.attempts);
-                        self.hand_over(observer, &point, if beyond_end { 1.0 } else { furthest });
+                        for i in 0..=n {
+                            self.step_direction[i] = self.z[i] - self.z_last[i];
+                        }
+                        let (scales, fraction) = (self.scale.variables(), if beyond_end { 1.0 } else { furthest });
+                        self.hand_over(observer, &point, fraction, scales, false);
                         points.push(point);
                         return if beyond_end {
                             TerminationReason::ReachedEnd
@@ -395,6 +419,8 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             for i in 0..=n {
                 self.previous_direction[i] = self.z[i] - self.z_last[i];
             }
+            self.step_direction.copy_from_slice(&self.previous_direction);
+            let scales = self.scale.variables();
             // The workspace holds ∂R at the accepted point: the tangent there, oriented along
             // the step taken (the secant if the bordered matrix is singular).
             let tangent_found = options.predictor == Predictor::Tangent && {
@@ -412,7 +438,7 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
             }
             let fraction = ((lambda_new - self.lambda_start) / (self.lambda_end - self.lambda_start)).clamp(0.0, 1.0);
             furthest = f64::max(furthest, fraction);
-            self.hand_over(observer, &point, furthest);
+            self.hand_over(observer, &point, furthest, scales, tangent_found);
             points.push(point);
             fallback_tangent = None;
 
@@ -430,13 +456,30 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         termination
     }
 
-    /// Hand an accepted point to the observer, the problem as the converged evaluation left it.
-    fn hand_over<O: PointObserver<P> + ?Sized>(&mut self, observer: &mut O, point: &Point, fraction_done: f64) {
+    /// Hand an accepted point to the observer, the problem as the converged evaluation left it;
+    /// `step_direction` holds the step that reached it, scaled by `scales`. With
+    /// `tangent_at_point`, the last tangent computed is the point's.
+    fn hand_over<O: PointObserver<P> + ?Sized>(
+        &mut self,
+        observer: &mut O,
+        point: &Point,
+        fraction_done: f64,
+        scales: VariableScales,
+        tangent_at_point: bool,
+    ) {
+        let factors = self.last_tangent_factors.take().filter(|_| tangent_at_point);
         let mut accepted = Accepted {
             point,
             fraction_done,
             residual_scale: self.scale.residual,
             completable: self.ws.lazy && self.last_residual_only,
+            // The converged evaluation included the Jacobian, and nothing factored it since.
+            jacobian_held: self.ws.holds_jacobian(),
+            direction: &self.step_direction,
+            scales,
+            tangent_factors: factors
+                .map(|(w_norm, determinant, at)| (self.last_tangent.as_slice(), w_norm, determinant, at)),
+            test_functions: None,
             problem: &mut *self.problem,
             workspace: &mut self.ws,
             calls: Calls::default(),
@@ -688,6 +731,13 @@ impl<'a, P: Problem + ?Sized> Runner<'a, P> {
         for (t, v) in self.tangent.iter_mut().zip(&self.ws.rhs) {
             *t = sign * v / length;
         }
+        // B(reference) w = e_{n+1} solved: the test functions there (singular's Eq. 2), with w
+        // oriented as the tangent.
+        self.last_tangent.copy_from_slice(&self.tangent);
+        self.last_tangent_factors = self.ws.bordered_determinant().map(|mut determinant| {
+            determinant.sign *= sign;
+            (length, determinant, self.scale.variables())
+        });
         true
     }
 }

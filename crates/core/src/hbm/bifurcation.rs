@@ -1,24 +1,36 @@
-//! Stability along a forced-response branch and its bifurcations: where a Floquet exponent
-//! ([`super::stability`]) crosses the imaginary axis between two accepted points.
+//! Bifurcations of a forced-response branch, from two sources:
 //!
-//! The kind follows from the exponent that crosses and from the branch itself:
-//! - a real exponent where the branch turns back in Ω: a **fold** (limit point; the response
-//!   jumps there in a sweep);
-//! - a real exponent where the branch goes on in the same direction: a **branch point**
-//!   (another branch of periodic solutions crosses this one);
-//! - an exponent with imaginary part ±Ω/2 (a multiplier through −1): a **period doubling**;
-//! - a complex pair otherwise: a **Neimark-Sacker** bifurcation (the response becomes
-//!   quasi-periodic).
+//! - **folds** (limit points: a sweep jumps there) and **branch points** (another branch of
+//!   periodic solutions crosses this one) from the continuation's own test functions, its
+//!   tangent and determinants at every accepted point ([`crate::continuation::singular_points`]):
+//!   one LU per point, so they are found at every sweep, with or without stability;
+//! - with stability (Hill's method, [`super::stability`]), where a complex pair of Floquet
+//!   exponents crosses the imaginary axis between two accepted points: a **period doubling**
+//!   when its imaginary part is ±Ω/2 (a multiplier through −1), a **Neimark-Sacker**
+//!   bifurcation otherwise (the response becomes quasi-periodic), located by [`zero_along`] on
+//!   the leading exponent's real part, along the branch.
 //!
-//! Each is located between its two points by [`zero_along`] on the leading exponent's real
-//! part, along the branch (through a fold as well as along an arc).
+//! A real exponent crosses zero exactly where the balance's Jacobian is singular. At s = 0
+//! (where the sliders' memory weights `e^{−sΔ}` are 1) Hill's matrix is the Jacobian of the
+//! balance in dynamic-stiffness form, `Z + E ∂G/∂x Eᵀ` (`Z` the linear part's dynamic
+//! stiffness, harmonic by harmonic, `E` the joints' directions), and the flexibility form the
+//! continuation solves is `∂R/∂x = I + H ∂G/∂x` with `H = Eᵀ Z⁻¹ E`; by Sylvester's
+//! determinant identity `det(Z + E ∂G/∂x Eᵀ) = det Z det(∂R/∂x)`, and `det Z ≠ 0` for a
+//! damped structure. The two vanish together up to Hill's truncation of the modes (those beyond
+//! the band act through their residual flexibility): on the Duffing oscillator, where no mode is
+//! left out, the folds from the tangent and from Hill's leading exponent are 4e-16 apart at most
+//! (`tests/stability_duffing.rs`), and at the symmetry-breaking branch point of two coupled
+//! oscillators 3e-12 (`tests/stability_branch_point.rs`). Real crossings are therefore taken
+//! from the test functions alone, which also see a fold or a branch point on a branch already
+//! unstable (where the stable flag does not change), and the exponents give the complex
+//! crossings only.
 
 use faer::{c64, Mat};
 
 use super::condensed::{CondensedHbm, HbmError};
 use super::stability::{Hill, Stability, StabilityError};
 use super::sweep::FrequencySweep;
-use crate::continuation::{zero_along, Point, ProblemError};
+use crate::continuation::{singular_points, zero_along, Point, Problem, ProblemError, SingularKind, TestFunctions};
 
 /// The kinds of bifurcation a forced response shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,9 +59,11 @@ pub struct Bifurcation {
     /// Where it is: Ω (rad/s) and the balance's unknowns.
     pub omega: f64,
     pub x: Vec<f64>,
-    /// The crossing exponent at the located point (real part ~0) and, for a Neimark-Sacker,
-    /// its imaginary part: the frequency of the new, incommensurate motion is that (rad/s).
-    pub exponent: c64,
+    /// For a bifurcation found from the Floquet exponents, the crossing exponent at the
+    /// located point (real part ~0); for a Neimark-Sacker, its imaginary part is the frequency
+    /// of the new, incommensurate motion (rad/s). `None` for a fold or a branch point, found
+    /// from the test functions: a real exponent crosses zero there.
+    pub exponent: Option<c64>,
     /// Index of the accepted point just before it.
     pub after_point: usize,
     /// False when the location failed: then `omega` and `x` are the point after the crossing.
@@ -207,10 +221,38 @@ pub fn is_stable(stability: &Stability, omega: f64) -> bool {
     stability.is_stable(EXPONENT_TOLERANCE * omega)
 }
 
-/// The bifurcations between consecutive points of a frequency-sweep branch at `level`, given
-/// each point's stability, each located along the branch to `tolerance` on the chord between
-/// its two points.
-pub fn bifurcations(
+/// The folds and branch points of a frequency-sweep branch of `problem` (the condensed balance
+/// or another in Ω, [`FrequencySweep`] or DLFT's), from the test functions of its points
+/// (`tests[i]` those of `points[i]`, [`crate::continuation::Accepted::test_functions`]), each
+/// located along the branch to `tolerance` on the chord between its two points.
+pub fn folds_and_branch_points<P: Problem>(
+    problem: &mut P,
+    points: &[Point],
+    tests: &[Option<TestFunctions>],
+    tolerance: f64,
+) -> Vec<Bifurcation> {
+    singular_points(problem, points, tests, tolerance)
+        .into_iter()
+        .map(|p| Bifurcation {
+            kind: match p.kind {
+                SingularKind::Fold => BifurcationKind::Fold,
+                SingularKind::BranchPoint => BifurcationKind::BranchPoint,
+            },
+            omega: p.lambda,
+            x: p.x,
+            exponent: None,
+            after_point: p.after_point,
+            located: p.located,
+        })
+        .collect()
+}
+
+/// The period doublings and Neimark-Sacker bifurcations between consecutive points of a
+/// frequency-sweep branch at `level`: where the stable flag changes and the leading exponent
+/// of the unstable point is complex (a real one is a fold or a branch point, found by
+/// [`folds_and_branch_points`]), given each point's stability, each located along the branch to
+/// `tolerance` on the chord between its two points.
+pub fn floquet_bifurcations(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
     level: f64,
@@ -228,19 +270,11 @@ pub fn bifurcations(
         let unstable = if s0 { &stabilities[i + 1] } else { &stabilities[i] };
         let omega = p0.lambda.max(p1.lambda);
         let im = unstable.leading().im.abs();
-        let kind = if im <= 1e-6 * omega {
-            // The branch turns back in Ω within the segments around the crossing?
-            let direction = |j: usize| points.get(j + 1).map(|b| (b.lambda - points[j].lambda).signum());
-            let here = direction(i);
-            let turned = [i.checked_sub(1).and_then(direction), direction(i + 1)]
-                .iter()
-                .any(|d| matches!((d, here), (Some(d), Some(h)) if *d != h));
-            if turned {
-                BifurcationKind::Fold
-            } else {
-                BifurcationKind::BranchPoint
-            }
-        } else if (im - 0.5 * omega).abs() <= 1e-6 * omega {
+        if im <= REAL * omega {
+            // A real exponent: a fold or a branch point, from the test functions.
+            continue;
+        }
+        let kind = if (im - 0.5 * omega).abs() <= REAL * omega {
             BifurcationKind::PeriodDoubling
         } else {
             BifurcationKind::NeimarkSacker
@@ -253,13 +287,13 @@ pub fn bifurcations(
             Ok(z) => {
                 let exponent =
                     stability_at(hbm, hill, &z.x, z.lambda).map(|s| s.leading()).unwrap_or(unstable.leading());
-                Bifurcation { kind, omega: z.lambda, x: z.x, exponent, after_point: i, located: true }
+                Bifurcation { kind, omega: z.lambda, x: z.x, exponent: Some(exponent), after_point: i, located: true }
             }
             Err(_) => Bifurcation {
                 kind,
                 omega: p1.lambda,
                 x: p1.x.clone(),
-                exponent: unstable.leading(),
+                exponent: Some(unstable.leading()),
                 after_point: i,
                 located: false,
             },
@@ -267,3 +301,8 @@ pub fn bifurcations(
     }
     found
 }
+
+/// Imaginary parts within this fraction of Ω of 0 (a real exponent) or of Ω/2 (a multiplier
+/// through −1) count as those: the exponents are accurate to ~1e-12 Ω (Hill's eigenproblem),
+/// ~1e-9 Ω with the sliders' memory refined.
+const REAL: f64 = 1e-6;

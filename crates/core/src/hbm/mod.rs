@@ -29,8 +29,8 @@ pub mod structured;
 pub mod sweep;
 
 pub use bifurcation::{
-    bifurcations, stability_at, stability_at_last_evaluation, stability_by_eigenproblems, Bifurcation, BifurcationKind,
-    BranchStabilityError,
+    floquet_bifurcations, folds_and_branch_points, stability_at, stability_at_last_evaluation,
+    stability_by_eigenproblems, Bifurcation, BifurcationKind, BranchStabilityError,
 };
 pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};

@@ -33,7 +33,8 @@ pub struct LevelResult {
     pub points: Vec<PointRecord>,
     /// Per output, the resonance peak located along the branch (empty when not located).
     pub peaks: Vec<Peak>,
-    /// Bifurcations along the branch (empty unless stability is computed).
+    /// Bifurcations along the branch: folds and branch points always, period doublings and
+    /// Neimark-Sacker bifurcations when stability is computed.
     pub bifurcations: Vec<BifurcationRecord>,
 }
 
@@ -91,7 +92,8 @@ pub struct BifurcationRecord {
     pub frequency_hz: f64,
     /// |X₁| at each output there (m), in the outputs' order.
     pub amplitudes: Vec<(String, f64)>,
-    /// Imaginary part of the crossing exponent (rad/s).
+    /// Imaginary part of the crossing Floquet exponent (rad/s): 0 at a fold or a branch point
+    /// (a real exponent crosses zero there).
     pub exponent_im: f64,
     /// False when it could not be located between its two points (then it is the second).
     pub located: bool,
@@ -177,7 +179,7 @@ pub fn harmonics_from_coefficients(coefficients: &[f64]) -> Vec<(f64, f64)> {
 }
 
 /// Write everything a run produces into `dir` (created if needed): `frf.csv`, `frf.npz`,
-/// `peaks.csv` (see [`write_peaks_csv`]), the
+/// `peaks.csv` (see [`write_peaks_csv`]), `bifurcations.csv` (see [`write_bifurcations_csv`]), the
 /// time data of the points that carry it (`points/`), and per output an FRF plot
 /// (`frf_<out>.<png|svg>`) and a phase plot (`frf_phase_<out>.<png|svg>`) and the plots of [`crate::plot::plot_level_details`], unless `plots`
 /// is `None` (batch runs). Returns the paths of the FRF table, the NPZ file and the plots.
@@ -206,12 +208,9 @@ fn write_tables(dir: &std::path::Path, levels: &[LevelResult]) -> Result<Vec<Pat
     write_frf_npz(&npz, levels)?;
     let peaks = dir.join("peaks.csv");
     write_peaks_csv(&peaks, &crate::report::peaks(levels))?;
-    let mut files = vec![csv, npz, peaks];
-    if levels.iter().flat_map(|l| &l.points).any(|p| p.stability.is_some()) {
-        let path = dir.join("bifurcations.csv");
-        write_bifurcations_csv(&path, levels)?;
-        files.push(path);
-    }
+    let bifurcations = dir.join("bifurcations.csv");
+    write_bifurcations_csv(&bifurcations, levels)?;
+    let files = vec![csv, npz, peaks, bifurcations];
     write_time_data(dir, levels)?;
     Ok(files)
 }
