@@ -459,7 +459,7 @@ struct PointRecorder<'s, O: ?Sized> {
     progress: &'s mut O,
     points: Vec<PointRecord>,
     stabilities: Vec<Stability>,
-    /// Per point, the continuation's test functions ([`Accepted::test_functions`]).
+    /// Per point, the continuation's test functions ([`Accepted::test_functions_estimate`]).
     tests: Vec<Option<TestFunctions>>,
     /// The first failure to post-process a point (the branch runs on; the level reports it).
     error: Option<SweepError>,
@@ -481,10 +481,10 @@ impl<O: Observer + ?Sized> PointRecorder<'_, O> {
         let residual = accepted.point().residual_norm / accepted.residual_scale();
         let (iterations, index) = (accepted.point().iterations, self.points.len());
         let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
-        // Before the problem is handed out: the Jacobian is completed from the converged
-        // evaluation. A point where they cannot be made has none (the folds and branch points
-        // on its two sides are not sought).
-        self.tests.push(accepted.test_functions().ok().flatten().cloned());
+        // Before the problem is handed out: from the corrector's last factorisation, or the
+        // Jacobian completed from the converged evaluation. A point where they cannot be made
+        // has none (the folds and branch points on its two sides are not sought).
+        self.tests.push(accepted.test_functions_estimate().ok().flatten().cloned());
         match results(accepted.problem(), &x, omega) {
             Ok((result, stability)) => {
                 let mut point = record(&result, iterations, residual, self.study.output_options.time_data.keeps(index));

@@ -27,6 +27,8 @@ pub(super) struct Workspace {
     transpositions: usize,
     /// Dense: `matrix` holds the Jacobian of the last evaluation, not yet factored.
     holds_jacobian: bool,
+    /// Dense: `matrix` holds the LU factors of the last bordered system solved.
+    holds_bordered_factors: bool,
     scratch: MemBuffer,
     /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
     factored: bool,
@@ -64,6 +66,7 @@ impl Workspace {
             perm_inv: vec![0; n + 1],
             transpositions: 0,
             holds_jacobian: false,
+            holds_bordered_factors: false,
             scratch: MemBuffer::new(req),
         }
     }
@@ -90,6 +93,7 @@ impl Workspace {
         }
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
+        self.holds_bordered_factors = false;
         problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))?;
         self.holds_jacobian = true;
         Ok(())
@@ -119,6 +123,7 @@ impl Workspace {
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
         jx.fill(0.0);
         self.holds_jacobian = false;
+        self.holds_bordered_factors = false;
         problem.complete_jacobian((jx, &mut self.dr_dlambda))?;
         self.holds_jacobian = true;
         Ok(())
@@ -172,7 +177,26 @@ impl Workspace {
         for (j, &tj) in t.iter().enumerate() {
             self.matrix[(n, j)] = tj;
         }
-        self.factor_and_solve(n + 1)
+        let solved = self.factor_and_solve(n + 1);
+        self.holds_bordered_factors = true;
+        solved
+    }
+
+    /// Does the (dense) matrix hold the LU factors of the last bordered system solved, no
+    /// evaluation with the Jacobian since?
+    pub fn holds_bordered_factors(&self) -> bool {
+        self.holds_bordered_factors
+    }
+
+    /// Solve `rhs` again with the factors of the last bordered system (only when
+    /// [`Self::holds_bordered_factors`]), in place. False if the solution is not finite.
+    pub fn solve_with_bordered_factors(&mut self) -> bool {
+        let size = self.n + 1;
+        let lu = self.matrix.as_ref();
+        let perm = faer::perm::PermRef::new_checked(&self.perm[..size], &self.perm_inv[..size], size);
+        let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs[..size], size, 1);
+        solve::solve_in_place(lu, lu, perm, rhs, Par::Seq, MemStack::new(&mut self.scratch));
+        self.rhs.iter().all(|v| v.is_finite())
     }
 
     /// Solve `∂R/∂x·s_x/s_R Δu = rhs[..n]` (a Newton step at fixed λ).
@@ -214,6 +238,7 @@ impl Workspace {
 
     fn factor_and_solve(&mut self, size: usize) -> bool {
         self.holds_jacobian = false;
+        self.holds_bordered_factors = false;
         let par = Par::Seq;
         let mut a = self.matrix.as_mut().submatrix_mut(0, 0, size, size);
         let stack = MemStack::new(&mut self.scratch);

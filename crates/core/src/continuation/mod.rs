@@ -575,6 +575,39 @@ impl<'a, P: Problem + ?Sized> Accepted<'a, P> {
     /// later [`Self::jacobian`] evaluates it again: ask for it first). The path of the
     /// continuation does not depend on it. `None` for a problem that factors its own
     /// Jacobian, or where the bordered matrix is singular.
+    /// [`Self::test_functions`], but where the converged evaluation was of the residual alone
+    /// and the corrector's last factorisation is still held, from that factorisation: at the
+    /// last Newton iterate before the point, within Newton's last update of it, for one solve
+    /// instead of the Jacobian and an LU. Their signs are the point's unless a fold or branch
+    /// point lies within that update; [`singular_points`] locates what they show by exact
+    /// evaluations. Elsewhere the exact test functions.
+    pub fn test_functions_estimate(&mut self) -> Result<Option<&TestFunctions>, ProblemError> {
+        if self.test_functions.is_none()
+            && self.tangent_factors.is_none()
+            && self.completable
+            && self.workspace.holds_bordered_factors()
+        {
+            let n = self.workspace.rhs.len() - 1;
+            self.workspace.rhs.iter_mut().for_each(|v| *v = 0.0);
+            self.workspace.rhs[n] = 1.0;
+            if self.workspace.solve_with_bordered_factors() {
+                if let Some(mut determinant) = self.workspace.bordered_determinant() {
+                    // B(r) w = e_{n+1}, r the corrector's hyperplane (Eq. 2 of `singular`),
+                    // w oriented along the step that reached the point; the bordered
+                    // determinant, linear in its last row, turns with it.
+                    let w = &self.workspace.rhs;
+                    let length = w.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    let along: f64 = w.iter().zip(self.direction).map(|(a, b)| a * b).sum();
+                    let sign = if along < 0.0 { -1.0 } else { 1.0 };
+                    determinant.sign *= sign;
+                    let tangent = w.iter().map(|v| sign * v / length).collect();
+                    self.test_functions = Some(Some(TestFunctions::new(tangent, length, determinant, self.scales)));
+                }
+            }
+        }
+        self.test_functions()
+    }
+
     pub fn test_functions(&mut self) -> Result<Option<&TestFunctions>, ProblemError> {
         if self.test_functions.is_none() {
             let found = match self.tangent_factors.take() {
