@@ -31,15 +31,23 @@
 //! moving vertically only, rigidly coupled to the bottom of the base plate and held by
 //! K_soft = 22800 N/m. Friction acts on the vertical component of each contact connector.
 //!
+//! The paper calls its one friction element per blade (Section 3.4, Eqs. 7-11) a
+//! simplification of a contact that is really an area: [`TipContact::Patch`] meshes that area
+//! instead. Each blade's tip face is shaped to the wall's radius and the wall is cut at the
+//! tip's own angular and vertical subdivisions, so the two faces have coincident, distinct
+//! nodes (node sets `TIP_FACE_i` and `WALL_FACE_i`) that a contact patch pairs node to node;
+//! no reference nodes, couplings or connectors are made there.
+//!
 //! Node numbering, independent of the refinement, so that studies can name DOFs
-//! (`"node.direction"`): shaker 1; blade i = 1..4: Top_Blade 10+i, Contact_Zone 20+i, blade
-//! screw references 30+i and 40+i, body screw references 50+i and 60+i; accelerometers 101..110
-//! (mesh nodes, see [`ACCELEROMETERS`]); other mesh nodes from 1001.
+//! (`"node.direction"`): shaker 1; blade i = 1..4: Top_Blade 10+i, Contact_Zone 20+i (with
+//! [`TipContact::Patch`], the mesh node at the centre of the tip face and the wall node facing
+//! it), blade screw references 30+i and 40+i, body screw references 50+i and 60+i;
+//! accelerometers 101..110 (mesh nodes, see [`ACCELEROMETERS`]); other mesh nodes from 1001.
 
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use crate::element::SolidKind;
-use crate::mesh::structured::{placed_box, revolve, GenerateError, Part, ProfileRect};
+use crate::mesh::structured::{placed_box, revolve_at, Block, GenerateError, Part, ProfileRect, QuarterAngles};
 use crate::mesh::{Material, Mesh, PointElement, RigidCoupling};
 
 /// Node id of the shaker's mass.
@@ -99,6 +107,45 @@ pub fn accelerometer(k: usize) -> u64 {
     101 + k as u64
 }
 
+/// How each blade tip meets the envelope wall.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TipContact {
+    /// The paper's model (Section 3.1): the tip face and the wall's contact zone rigidly
+    /// coupled to reference nodes (Top_Blade, Contact_Zone) joined by a connector, on whose
+    /// vertical component one friction element acts.
+    #[default]
+    Connector,
+    /// Conforming faces: the tip face shaped to the wall's radius, the wall cut at the tip's
+    /// angular and vertical subdivisions, coincident nodes in `TIP_FACE_i` and `WALL_FACE_i`
+    /// (the two bodies apart) for a node-to-node contact patch.
+    Patch,
+}
+
+impl TipContact {
+    /// The key that chooses it, and the values it takes.
+    pub const KEY: &'static str = "tip_contact";
+    pub const VALUES: [&'static str; 2] = ["connector", "patch"];
+}
+
+impl std::str::FromStr for TipContact {
+    type Err = GenerateError;
+
+    fn from_str(value: &str) -> Result<TipContact, GenerateError> {
+        match value {
+            "connector" => Ok(TipContact::Connector),
+            "patch" => Ok(TipContact::Patch),
+            other => Err(GenerateError::Geometry {
+                part: "harmony".into(),
+                msg: format!(
+                    "{} must be {}, got {other:?}",
+                    TipContact::KEY,
+                    TipContact::VALUES.map(|v| format!("{v:?}")).join(" or ")
+                ),
+            }),
+        }
+    }
+}
+
 /// Dimensions (m), materials, masses (kg) and joint values of the Harmony-like assembly.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Design {
@@ -140,6 +187,8 @@ pub struct Design {
     pub connector_stiffness: f64,
     /// Vertical stiffness of the contact connectors; 0 releases them (all blades slipping).
     pub contact_vertical_stiffness: f64,
+    /// Connectors at the blade tips (the paper's) or conforming faces for contact patches.
+    pub tip_contact: TipContact,
     pub shaker_mass: f64,
     pub shaker_spring: f64,
     /// Radius of the base plate's bottom zone rigidly coupled to the shaker (the shaker's
@@ -177,6 +226,7 @@ impl Default for Design {
             contact_zone_half_height: 0.010,
             connector_stiffness: 1e10,
             contact_vertical_stiffness: 1e10,
+            tip_contact: TipContact::Connector,
             shaker_mass: 10.0,
             shaker_spring: 22800.0,
             shaker_zone_radius: 0.040,
@@ -474,7 +524,7 @@ impl Design {
     pub fn estimated_dofs(&self) -> Result<usize, GenerateError> {
         let d = self.dimensions()?;
         let h = self.element_size;
-        let sectors = self.sectors() as f64;
+        let sectors = 4.0 * self.quarter_angles(&d).cells() as f64;
         let z = self.heights(&d)[6];
         let radial = (self.envelope_radius / h).ceil() + 6.0;
         let axial = (z / h).ceil() + 8.0;
@@ -501,6 +551,30 @@ impl Design {
         s.div_ceil(8).max(2).saturating_mul(8)
     }
 
+    /// Angles at which each quarter turn of the revolved part is cut. With
+    /// [`TipContact::Patch`] the quarter's centre (a blade's plane) carries the tip's
+    /// subdivisions across the blade, ±`tip_half_angle` each side, and equal sectors outside;
+    /// an equal sector's edge within half a sector of the blade is left out (no sliver).
+    fn quarter_angles(&self, d: &Dimensions) -> QuarterAngles {
+        let quarter = self.sectors() / 4;
+        if self.tip_contact == TipContact::Connector {
+            return QuarterAngles::Uniform(quarter);
+        }
+        let half = self.tip_half_angle(d);
+        let step = FRAC_PI_2 / quarter as f64;
+        let across = self.blade_cells()[1];
+        let mut stations = vec![-FRAC_PI_4, FRAC_PI_4];
+        stations.extend((1..quarter).map(|j| -FRAC_PI_4 + j as f64 * step).filter(|t| t.abs() >= half + 0.5 * step));
+        stations.extend((0..=across).map(|k| half * (2.0 * k as f64 / across as f64 - 1.0)));
+        stations.sort_by(f64::total_cmp);
+        QuarterAngles::Stations(stations)
+    }
+
+    /// Half the angle a blade's tip spans on the wall (rad): its edges lie on the wall's circle.
+    fn tip_half_angle(&self, d: &Dimensions) -> f64 {
+        (0.5 * d.blade_width / d.envelope_inner_radius).asin()
+    }
+
     fn blade_cells(&self) -> [usize; 3] {
         let along = ((self.blade_length / (0.5 * self.element_size)).ceil() as usize).max(8);
         if let Some(h) = self.variant.blade_height {
@@ -511,13 +585,72 @@ impl Design {
         [along, across, 1 + (self.element_size < 0.01) as usize]
     }
 
+    /// A blade of [`TipContact::Patch`] along the unit vector `[c, s]`: the placed box of the
+    /// connector model, but cut across at equal angles seen from the axis and ending on the
+    /// wall's circle, so that each tip node lies on the wall at one of the angles that
+    /// [`Design::quarter_angles`] gives the wall. The tip's edges stay at ±width/2; its corners
+    /// move in by at most width²/(8 R), 0.12 mm for the default design, about 0.07 % of the
+    /// blade's volume.
+    fn blade_on_wall(&self, d: &Dimensions, [c, s]: [f64; 2], disk_top: f64) -> Block {
+        let (radius, half, vertical) = (d.envelope_inner_radius, self.tip_half_angle(d), self.blade_vertical());
+        let root = radius - self.blade_length;
+        Block {
+            cells: self.blade_cells(),
+            map: Box::new(move |[u, v, w]| {
+                let angle = half * (2.0 * v - 1.0);
+                let along = root + u * (radius * angle.cos() - root);
+                let across = radius * angle.sin();
+                [along * c - across * s, along * s + across * c, disk_top + w * vertical]
+            }),
+            elset: "BLADES".into(),
+        }
+    }
+
+    /// For each blade of [`TipContact::Patch`], its tip nodes paired with the revolved part's
+    /// wall nodes at the same positions, and the pair at the centre of the tip face (height
+    /// `z_centre`). An error names the blade and the position of a tip node the wall lacks.
+    fn tip_faces(
+        &self,
+        blades: &[Part],
+        revolved: &Part,
+        d: &Dimensions,
+        z_centre: f64,
+        tol: f64,
+    ) -> Result<Vec<TipFace>, GenerateError> {
+        let radius = d.envelope_inner_radius;
+        let mut faces = Vec::with_capacity(blades.len());
+        for (i, part) in blades.iter().enumerate() {
+            let mut pairs = Vec::new();
+            for n in part.nodes_where(|x| (x[0].hypot(x[1]) - radius).abs() < tol) {
+                let x = part.nodes[n];
+                let w = revolved.nearest(x);
+                if dist2(revolved.nodes[w], x).sqrt() > tol {
+                    return Err(self.fail(format!(
+                        "the tip of blade {} does not conform to the envelope wall: no wall node at {x:?} m",
+                        i + 1
+                    )));
+                }
+                pairs.push((n, w));
+            }
+            let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i];
+            let middle = [radius * c, radius * s, z_centre];
+            let centre = *pairs
+                .iter()
+                .min_by(|a, b| dist2(part.nodes[a.0], middle).total_cmp(&dist2(part.nodes[b.0], middle)))
+                .ok_or_else(|| self.fail(format!("blade {} has no node on the envelope wall", i + 1)))?;
+            faces.push(TipFace { pairs, centre });
+        }
+        Ok(faces)
+    }
+
     /// The mesh of a configuration, with its sets, couplings, connectors, shaker and sensors.
     pub fn build(&self, configuration: Configuration) -> Result<Mesh, GenerateError> {
         let d = self.dimensions()?;
         let [base_top, ring_top, diaphragm_bottom, disk_bottom, disk_top, blade_top, envelope_top] = self.heights(&d);
         let tol = 1e-7 * self.envelope_radius;
         let size = self.element_size;
-        let sectors = self.sectors();
+        let angles = self.quarter_angles(&d);
+        let patch = self.tip_contact == TipContact::Patch;
         let rect = |r: [f64; 2], z: [f64; 2], set: &str| ProfileRect { r, z, elset: set.into() };
         let with_body = configuration != Configuration::Envelope;
         let with_envelope = configuration != Configuration::BodyWithBlades;
@@ -538,7 +671,7 @@ impl Design {
             ));
             // The wall, cut at the blades' heights so that the contact zones have nodes there.
             let zc = 0.5 * (disk_top + blade_top);
-            let mut cuts = [
+            let mut cuts = vec![
                 ring_top,
                 zc - self.contact_zone_half_height,
                 disk_top,
@@ -546,6 +679,11 @@ impl Design {
                 zc + self.contact_zone_half_height,
                 envelope_top,
             ];
+            if patch {
+                // The tip's vertical subdivisions, so that the wall's nodes meet the tip's.
+                let cells = self.blade_cells()[2];
+                cuts.extend((1..cells).map(|k| disk_top + k as f64 / cells as f64 * self.blade_vertical()));
+            }
             cuts.sort_by(f64::total_cmp);
             for w in cuts.windows(2) {
                 if w[1] > w[0] + tol {
@@ -595,7 +733,7 @@ impl Design {
             }
         }
         let mut revolved = Part::new("STRUCTURE", self.kind, tol)?;
-        revolve(&mut revolved, &profile, sectors, size)?;
+        revolve_at(&mut revolved, &profile, &angles, size)?;
 
         // Blades along x, y, -x, -y: lying on the top disk, tip against the envelope wall.
         let mut blades = Vec::new();
@@ -611,7 +749,11 @@ impl Design {
                     [0.0, 0.0, self.blade_vertical()],
                 ];
                 let mut part = Part::new(&format!("BLADE_{}", i + 1), self.kind, tol)?;
-                part.add_block(&placed_box(origin, edges, self.blade_cells(), "BLADES"))?;
+                if patch {
+                    part.add_block(&self.blade_on_wall(&d, [c, s], disk_top))?;
+                } else {
+                    part.add_block(&placed_box(origin, edges, self.blade_cells(), "BLADES"))?;
+                }
                 blades.push(part);
             }
         }
@@ -651,21 +793,34 @@ impl Design {
             ("BODY", "STEEL_304L", self.steel_304l.clone()),
             ("BLADES", "Z8CND17-04", self.blade_steel.clone()),
         ];
+        // Conforming tips: each tip node's partner on the wall (part node indices), and the
+        // nodes named Top_Blade and Contact_Zone, at the centre of the tip face.
+        let faces = if patch && with_envelope {
+            self.tip_faces(&blades, &revolved, &d, 0.5 * (disk_top + blade_top), tol)?
+        } else {
+            Vec::new()
+        };
         let mut next_id = 1001u64;
         let structure_ids: Vec<u64> = (0..revolved.nodes.len())
             .map(|n| match sensor_nodes.iter().find(|&&(_, _, s)| s == n) {
                 Some(&(k, _, _)) => accelerometer(k),
-                None => {
-                    next_id += 1;
-                    next_id - 1
-                }
+                None => match faces.iter().position(|f| f.centre.1 == n) {
+                    Some(i) => contact_zone(i + 1),
+                    None => {
+                        next_id += 1;
+                        next_id - 1
+                    }
+                },
             })
             .collect();
         let structure = revolved.add_to(&mut mesh, &structure_ids, 1, &materials)?;
         let mut blade_index = Vec::new();
         let mut next_element = revolved.elements.len() as u64 + 1;
-        for part in &blades {
-            let ids: Vec<u64> = (0..part.nodes.len()).map(|n| next_id + n as u64).collect();
+        for (i, part) in blades.iter().enumerate() {
+            let mut ids: Vec<u64> = (0..part.nodes.len()).map(|n| next_id + n as u64).collect();
+            if let Some(face) = faces.get(i) {
+                ids[face.centre.0] = top_blade(i + 1);
+            }
             next_id += part.nodes.len() as u64;
             blade_index.push(part.add_to(&mut mesh, &ids, next_element, &materials)?);
             next_element += part.elements.len() as u64;
@@ -709,11 +864,6 @@ impl Design {
                 let idx = &blade_index[i];
                 let bottom: Vec<usize> =
                     part.nodes_where(|x| (x[2] - disk_top).abs() < tol).iter().map(|&n| idx[n]).collect();
-                let tip: Vec<usize> = part
-                    .nodes_where(|x| (x[0] * c + x[1] * s - d.envelope_inner_radius).abs() < tol)
-                    .iter()
-                    .map(|&n| idx[n])
-                    .collect();
                 for (j, &r) in self.screw_radii.iter().enumerate() {
                     let centre = [r * c, r * s, disk_top];
                     let b = add_ref(
@@ -740,6 +890,24 @@ impl Design {
                     });
                     connector(&mut mesh, a, b, [k; 6]);
                 }
+                for j in 0..2 {
+                    let b = mesh.node(blade_screws(i + 1)[j]).expect("added above");
+                    mesh.add_node_set("BLADE_SCREWS", [b]);
+                }
+                if patch {
+                    let tip = part.nodes_where(|x| (x[0].hypot(x[1]) - d.envelope_inner_radius).abs() < tol);
+                    mesh.add_node_set(&format!("TIP_FACE_{}", i + 1), tip.iter().map(|&n| idx[n]));
+                    if let Some(face) = faces.get(i) {
+                        let wall = face.pairs.iter().map(|&(_, w)| structure[w]);
+                        mesh.add_node_set(&format!("WALL_FACE_{}", i + 1), wall);
+                    }
+                    continue;
+                }
+                let tip: Vec<usize> = part
+                    .nodes_where(|x| (x[0] * c + x[1] * s - d.envelope_inner_radius).abs() < tol)
+                    .iter()
+                    .map(|&n| idx[n])
+                    .collect();
                 let zc = 0.5 * (disk_top + blade_top);
                 let tip_point = [d.envelope_inner_radius * c, d.envelope_inner_radius * s, zc];
                 let t = add_ref(&mut mesh, top_blade(i + 1), tip_point, &format!("TOP_BLADE_{}", i + 1))?;
@@ -773,10 +941,6 @@ impl Design {
                     // component is the one friction acts on (Section 3.1).
                     connector(&mut mesh, t, cz, [k, k, self.contact_vertical_stiffness, 0.0, 0.0, 0.0]);
                     mesh.add_node_set("CONTACT_ZONES", [cz]);
-                }
-                for j in 0..2 {
-                    let b = mesh.node(blade_screws(i + 1)[j]).expect("added above");
-                    mesh.add_node_set("BLADE_SCREWS", [b]);
                 }
             }
         }
@@ -821,6 +985,13 @@ impl Design {
         }
         Ok(mesh)
     }
+}
+
+/// A blade tip of [`TipContact::Patch`] on the wall: (blade part node, revolved part node)
+/// pairs at the same positions, and the pair at the centre of the face.
+struct TipFace {
+    pairs: Vec<(usize, usize)>,
+    centre: (usize, usize),
 }
 
 /// Whether the nodes lie on one line (a coupling on them would leave a rotation free).

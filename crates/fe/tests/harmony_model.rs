@@ -5,8 +5,9 @@
 
 use stickslip_fe::assembly::FeModel;
 use stickslip_fe::eigen::{solve, to_sparse, EigenOptions};
-use stickslip_fe::harmony::{self, BodyVariant, Configuration, Design};
+use stickslip_fe::harmony::{self, BodyVariant, Configuration, Design, TipContact};
 use stickslip_fe::mesh::structured::GenerateError;
+use stickslip_fe::patch::pair_sets;
 
 /// Frequencies (Hz) of the axial modes among the lowest `count`: those where the top of the
 /// central body (accelerometer 101) moves vertically more than a tenth of the most it does.
@@ -163,5 +164,93 @@ fn geometry_that_cannot_be_built_is_refused_naming_the_key() {
             Err(GenerateError::Geometry { msg, .. }) => assert!(msg.contains(key), "{key}: {msg}"),
             other => panic!("{key}: expected a geometry error, got {:?}", other.map(|m| m.nodes.len())),
         }
+    }
+}
+
+/// Which connected body (solids sharing nodes) each mesh node belongs to; nodes on no solid
+/// (reference nodes) get their own.
+fn bodies(mesh: &stickslip_fe::mesh::Mesh) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..mesh.nodes.len()).collect();
+    fn root(parent: &mut [usize], mut n: usize) -> usize {
+        while parent[n] != n {
+            parent[n] = parent[parent[n]];
+            n = parent[n];
+        }
+        n
+    }
+    for s in &mesh.solids {
+        for &n in &s.nodes[1..] {
+            let (a, b) = (root(&mut parent, s.nodes[0]), root(&mut parent, n));
+            parent[a] = b;
+        }
+    }
+    (0..mesh.nodes.len()).map(|n| root(&mut parent, n)).collect()
+}
+
+#[test]
+fn patch_tips_meet_the_wall_on_coincident_nodes_of_separate_bodies() {
+    let design = Design { tip_contact: TipContact::Patch, ..Design::refined(0.5) };
+    let mesh = design.build(Configuration::Assembly).unwrap();
+    let body = bodies(&mesh);
+    let revolved = body[mesh.node(harmony::accelerometer(0)).unwrap()];
+    for i in 1..=4 {
+        let tip = mesh.node_set(&format!("TIP_FACE_{i}")).unwrap();
+        let wall = mesh.node_set(&format!("WALL_FACE_{i}")).unwrap();
+        // Hex20, 2 cells across the blade and 1 through its thickness: 3 × 2 corners, 4 + 3
+        // mid-edge nodes.
+        assert_eq!((tip.len(), wall.len()), (13, 13), "blade {i}");
+        let blade = body[tip[0]];
+        assert_ne!(blade, revolved);
+        for &t in tip {
+            let x = mesh.nodes[t].xyz;
+            let partner: Vec<usize> = wall
+                .iter()
+                .copied()
+                .filter(|&w| (0..3).map(|d| (mesh.nodes[w].xyz[d] - x[d]).powi(2)).sum::<f64>().sqrt() < 1e-12)
+                .collect();
+            assert_eq!(
+                partner.len(),
+                1,
+                "blade {i}: tip node {} has {} wall nodes at {x:?}",
+                mesh.nodes[t].id,
+                partner.len()
+            );
+            assert_ne!(partner[0], t);
+            assert_eq!(body[t], blade);
+            assert_eq!(
+                body[partner[0]], revolved,
+                "blade {i}: wall node {} is not the envelope's",
+                mesh.nodes[partner[0]].id
+            );
+        }
+        // The patch pairing finds the same 13 pairs, with the tip face's area and a radial normal.
+        let patch = pair_sets(&mesh, &format!("TIP_FACE_{i}"), &format!("WALL_FACE_{i}"), None, None).unwrap();
+        assert_eq!(patch.pairs.len(), 13);
+        let d = design.dimensions().unwrap();
+        let flat = d.blade_width * design.blade_thickness;
+        assert!((patch.area() - flat).abs() < 1e-3 * flat, "blade {i}: tip area {} m² vs {flat} m²", patch.area());
+        let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i - 1];
+        assert!((patch.normal[0] - c).abs() < 1e-12 && (patch.normal[1] - s).abs() < 1e-12, "{:?}", patch.normal);
+        // Named centre nodes: Top_Blade on the tip, Contact_Zone on the wall, at one position.
+        let (p, b) = (mesh.node(harmony::top_blade(i)).unwrap(), mesh.node(harmony::contact_zone(i)).unwrap());
+        assert!(tip.contains(&p) && wall.contains(&b));
+        assert!((0..3).all(|k| (mesh.nodes[p].xyz[k] - mesh.nodes[b].xyz[k]).abs() < 1e-12));
+    }
+    // No reference nodes, couplings or connectors at the tips: the screws' (8 per blade pair
+    // of references, 16 couplings) and the shaker's remain.
+    assert!(mesh.node_set("TOP_BLADES").is_none() && mesh.node_set("CONTACT_ZONES").is_none());
+    assert_eq!(mesh.couplings.len(), 4 * 4 + 1);
+}
+
+#[test]
+fn tip_contact_takes_connector_or_patch_only() {
+    assert_eq!("patch".parse::<TipContact>().unwrap(), TipContact::Patch);
+    assert_eq!("connector".parse::<TipContact>().unwrap(), TipContact::Connector);
+    assert_eq!(Design::default().tip_contact, TipContact::Connector);
+    match "glued".parse::<TipContact>() {
+        Err(GenerateError::Geometry { msg, .. }) => {
+            assert_eq!(msg, "tip_contact must be \"connector\" or \"patch\", got \"glued\"")
+        }
+        other => panic!("expected an error, got {other:?}"),
     }
 }

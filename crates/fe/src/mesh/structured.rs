@@ -13,7 +13,9 @@
 //! each interval cut into cells no larger than the target size), so that rectangles sharing an
 //! edge always share its nodes. Rectangles reaching the axis (r = 0) get an O-grid: a square core
 //! and a ring that blends the square into the first circle, so there is no degenerate element on
-//! the axis.
+//! the axis. Around the axis the body is cut into equal sectors, or at given angles
+//! ([`QuarterAngles`]) where another part must find nodes of the body at its own nodes' angles
+//! (a blade tip against a wall, meshed as a conforming contact interface).
 
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
@@ -239,16 +241,84 @@ fn stations(ends: impl Iterator<Item = f64>, size: f64, tol: f64) -> (Vec<f64>, 
     (s, cells)
 }
 
+/// The angles (rad) at which each quarter turn of a revolved body is cut, the same in the four
+/// quarters: the quarter centred on the x axis spans −π/4..π/4 and the others are its exact
+/// quarter-turn rotations.
+#[derive(Clone, Debug, PartialEq)]
+pub enum QuarterAngles {
+    /// This many equal sectors per quarter.
+    Uniform(usize),
+    /// Increasing angles from −π/4 to π/4, both included; a hex20's mid-edge node lies at the
+    /// mean angle of its corners.
+    Stations(Vec<f64>),
+}
+
+impl QuarterAngles {
+    /// Number of sectors in a quarter.
+    pub fn cells(&self) -> usize {
+        match self {
+            QuarterAngles::Uniform(n) => *n,
+            QuarterAngles::Stations(s) => s.len().saturating_sub(1),
+        }
+    }
+
+    /// The angle at parameter `v ∈ [0, 1]` across the quarter: linear between the stations,
+    /// each station at `v = j / cells`.
+    fn at(&self, v: f64) -> f64 {
+        match self {
+            QuarterAngles::Uniform(_) => -FRAC_PI_4 + v * FRAC_PI_2,
+            QuarterAngles::Stations(s) => {
+                let n = s.len() - 1;
+                let x = v * n as f64;
+                let j = (x.floor() as usize).min(n - 1);
+                s[j] + (x - j as f64) * (s[j + 1] - s[j])
+            }
+        }
+    }
+
+    fn check(&self) -> Result<(), String> {
+        match self {
+            QuarterAngles::Uniform(0) => Err("a quarter needs at least one sector".into()),
+            QuarterAngles::Uniform(_) => Ok(()),
+            QuarterAngles::Stations(s) => {
+                let ends =
+                    s.len() >= 2 && (s[0] + FRAC_PI_4).abs() <= 1e-12 && (s[s.len() - 1] - FRAC_PI_4).abs() <= 1e-12;
+                if ends && s.windows(2).all(|w| w[1] > w[0]) {
+                    Ok(())
+                } else {
+                    Err(format!("angular stations must increase from -pi/4 to pi/4, got {s:?}"))
+                }
+            }
+        }
+    }
+}
+
 /// Revolve a profile about the z axis into `part`: a body of revolution meshed with `sectors`
-/// cells around (a multiple of 4) and cells at most `size` long in r and z.
+/// equal cells around (a multiple of 4) and cells at most `size` long in r and z.
 ///
 /// Errors: empty or inverted rectangles, negative radii, overlapping rectangles, a sector
 /// count that is not a positive multiple of 4.
 pub fn revolve(part: &mut Part, profile: &[ProfileRect], sectors: usize, size: f64) -> Result<(), GenerateError> {
-    let fail = |msg: String| GenerateError::Geometry { part: part.name.clone(), msg };
     if sectors == 0 || !sectors.is_multiple_of(4) {
-        return Err(fail(format!("sectors must be a positive multiple of 4, got {sectors}")));
+        return Err(GenerateError::Geometry {
+            part: part.name.clone(),
+            msg: format!("sectors must be a positive multiple of 4, got {sectors}"),
+        });
     }
+    revolve_at(part, profile, &QuarterAngles::Uniform(sectors / 4), size)
+}
+
+/// [`revolve`] with the sectors of each quarter turn cut at `angles`. The O-grid core of a
+/// solid disk keeps equal cells; its ring blends them into the given angles on the first
+/// circle.
+pub fn revolve_at(
+    part: &mut Part,
+    profile: &[ProfileRect],
+    angles: &QuarterAngles,
+    size: f64,
+) -> Result<(), GenerateError> {
+    let fail = |msg: String| GenerateError::Geometry { part: part.name.clone(), msg };
+    angles.check().map_err(fail)?;
     if !(size > 0.0 && size.is_finite()) {
         return Err(fail(format!("element size must be > 0 m, got {size}")));
     }
@@ -271,7 +341,7 @@ pub fn revolve(part: &mut Part, profile: &[ProfileRect], sectors: usize, size: f
     let tol = part.tolerance;
     let (rs, r_cells) = stations(profile.iter().flat_map(|p| p.r), size, tol);
     let (zs, z_cells) = stations(profile.iter().flat_map(|p| p.z), size, tol);
-    let quarter = sectors / 4;
+    let quarter = angles.cells();
     let find = |s: &[f64], x: f64| s.iter().position(|&y| (y - x).abs() <= tol).expect("a station of the profile");
     for p in profile {
         let (i0, i1) = (find(&rs, p.r[0]), find(&rs, p.r[1]));
@@ -291,11 +361,12 @@ pub fn revolve(part: &mut Part, profile: &[ProfileRect], sectors: usize, size: f
                     })?;
                     let n_ring = (((rb - a) / size).ceil() as usize).max(1);
                     for q in 0..4 {
+                        let angles = angles.clone();
                         part.add_block(&Block {
                             cells: [n_ring, quarter, nz],
                             map: Box::new(move |[u, v, w]| {
                                 let square = [a, a * (2.0 * v - 1.0)];
-                                let t = -FRAC_PI_4 + v * FRAC_PI_2;
+                                let t = angles.at(v);
                                 let circle = [rb * t.cos(), rb * t.sin()];
                                 let x = [0, 1].map(|d| (1.0 - u) * square[d] + u * circle[d]);
                                 let [x, y] = rotate_quarter(x, q);
@@ -306,11 +377,12 @@ pub fn revolve(part: &mut Part, profile: &[ProfileRect], sectors: usize, size: f
                     }
                 } else {
                     for q in 0..4 {
+                        let angles = angles.clone();
                         part.add_block(&Block {
                             cells: [r_cells[i], quarter, nz],
                             map: Box::new(move |[u, v, w]| {
                                 let r = ra + u * (rb - ra);
-                                let t = -FRAC_PI_4 + v * FRAC_PI_2;
+                                let t = angles.at(v);
                                 let [x, y] = rotate_quarter([r * t.cos(), r * t.sin()], q);
                                 [x, y, za + w * (zb - za)]
                             }),

@@ -78,6 +78,7 @@ pub(crate) struct RawHarmony {
     pub shaker_zone_radius: Option<S<f64>>,
     pub connector_stiffness: Option<S<f64>>,
     pub screw_zone_radius: Option<S<f64>>,
+    pub tip_contact: Option<S<String>>,
 }
 
 #[derive(Deserialize)]

@@ -453,6 +453,9 @@ fn harmony(src: &Source, h: &S<raw::RawHarmony>) -> Result<stickslip_fe::harmony
             }
         };
     }
+    if let Some(t) = &r.tip_contact {
+        d.tip_contact = t.get_ref().parse().map_err(|e| src.invalid(&t.span(), format!("{CTX}: {e}")))?;
+    }
     let lengths: [(&str, &Option<S<f64>>, &mut f64, &str); 10] = [
         ("diaphragm_thickness", &r.diaphragm_thickness, &mut d.diaphragm_thickness, " m"),
         ("blade_thickness", &r.blade_thickness, &mut d.blade_thickness, " m"),
