@@ -56,9 +56,9 @@ fn stuck_peak(study: &Study, built: &(NonlinearModel, Excitation, Vec<OutputSpec
 const TOLERANCE: f64 = 0.01;
 
 const COARSE_LOW: [(&str, &str); 3] = [
-    ("levels = [70.0, 1070.0, 2910.0, 10000.0]", "levels = [70.0]"),
-    ("start_hz = 300.0", "start_hz = 260.0"),
-    ("end_hz = 170.0", "end_hz = 235.0"),
+    ("levels = [70.0, 1070.0]", "levels = [70.0]"),
+    ("start_hz = 255.0", "start_hz = 260.0"),
+    ("end_hz = 228.0", "end_hz = 235.0"),
 ];
 
 #[test]
@@ -102,8 +102,9 @@ fn harmony_blade_patches_pair_up_carry_the_papers_threshold_and_stick_near_the_c
     // Both have the connector's 1e10 N/m tangentially; they differ in what holds the tip's
     // rotation (the patch's normal stiffness times the face's second moment, 145 N m/rad,
     // against nothing) and in the wall (elastic under the patch, a rigid zone under the
-    // connector), and the patch mesh is cut at more angles. Measured -0.26 %; with ten times
-    // the normal stiffness the rotation's restraint alone gives +3.4 % (docs/contact-patches.md).
+    // connector), and the patch mesh is cut at more angles. Measured -0.26 %; ten times the
+    // normal stiffness restrains the rotation enough to move the peak by +3.4 % or more
+    // (docs/contact-patches.md): 1 % admits the first and refuses the second.
     let relative = (f_patch - f_connector).abs() / f_connector;
     assert!(relative < TOLERANCE, "patches {f_patch} Hz against the connector's {f_connector} Hz");
 }
