@@ -669,7 +669,7 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
         ramp(omega_start),
     )?;
     let band = (omega_end - omega_start).abs();
-    resumed_past_stops(
+    Ok(resumed_past_stops(
         dlft,
         branch,
         omega_end,
@@ -699,7 +699,7 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
                 observer,
             )
         },
-    )
+    ))
 }
 
 /// Continue the DLFT balance at frequency `omega` (rad/s) in the force level from

@@ -181,7 +181,7 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
         ramp(omega_start),
     )?;
     let band = (omega_end - omega_start).abs();
-    resumed_past_stops(
+    Ok(resumed_past_stops(
         hbm,
         branch,
         omega_end,
@@ -201,7 +201,7 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
             let rest = within(options, band, from, omega_end);
             continue_branch(&mut FrequencySweep { hbm, level }, guess, from, omega_end, &rest, observer)
         },
-    )
+    ))
 }
 
 /// The options of a continuation over `from..to`, a part of a band `band` long, with the same
@@ -234,7 +234,8 @@ const SAME_SOLUTION: f64 = 1e-6;
 /// branch stopped at, the sweep goes on (`forward(balance, guess, from)`) from the bridge's point
 /// next to the stop: the bridge shows that the points on either side of the stop are one branch.
 /// A bridge that arrives elsewhere (another branch, across a jump) or not at all leaves the stop
-/// as it was. Returns the branch, its resumptions in `resumed`.
+/// as it was, as does a rest of the sweep that fails to start. Returns the branch, its
+/// resumptions in `resumed`.
 pub(crate) fn resumed_past_stops<B: ?Sized>(
     balance: &mut B,
     mut branch: Branch,
@@ -243,7 +244,7 @@ pub(crate) fn resumed_past_stops<B: ?Sized>(
     band: f64,
     mut bridge: impl FnMut(&mut B, &[f64], f64, f64) -> Result<Branch, SweepError>,
     mut forward: impl FnMut(&mut B, &[f64], f64) -> Result<Branch, ContinuationError>,
-) -> Result<Branch, SweepError> {
+) -> Branch {
     while branch.resumed.len() < MAX_RESUMPTIONS && matches!(branch.termination, TerminationReason::StepTooSmall { .. })
     {
         let Some(last) = branch.points.last() else { break };
@@ -266,14 +267,15 @@ pub(crate) fn resumed_past_stops<B: ?Sized>(
             }
         }
         let Some((restarted_at, next)) = resumed else { break };
-        let rest = forward(balance, &next.x, next.lambda)?;
+        // A rest that cannot even start leaves the stop as it was, with its points.
+        let Ok(rest) = forward(balance, &next.x, next.lambda) else { break };
         branch.resumed.push(Resumption { stopped_at, restarted_at });
         branch.points.extend(rest.points);
         branch.termination = rest.termination;
         branch.calls += rest.calls;
         branch.residual_scale = branch.residual_scale.max(rest.residual_scale);
     }
-    Ok(branch)
+    branch
 }
 
 /// A frequency sweep of `balance` from `guess` (`frequency`); when Newton cannot reach its
@@ -477,8 +479,7 @@ mod tests {
                 rests.push((guess[0], from));
                 Ok(forward(from))
             },
-        )
-        .unwrap();
+        );
         (result, bridges, rests)
     }
 
@@ -540,5 +541,23 @@ mod tests {
         assert_eq!(bridges.len(), MAX_RESUMPTIONS);
         assert_eq!(result.resumed.len(), MAX_RESUMPTIONS);
         assert_eq!(result.termination, stopped());
+    }
+
+    #[test]
+    fn a_rest_that_fails_to_start_leaves_the_stop_with_its_points() {
+        let options = Options { max_step: 0.5, ..Options::default() };
+        let branch = with(&[(1.0, 1.0), (2.0, 2.0)], stopped());
+        let result = resumed_past_stops(
+            &mut (),
+            branch,
+            10.0,
+            &options,
+            9.0,
+            |_, _, from, _| bridge_to(from, 2.0),
+            |_, _, _| Err(ContinuationError::WrongGuessLength { len: 0, expected: 1 }),
+        );
+        assert_eq!(result.points.len(), 2);
+        assert_eq!(result.termination, stopped());
+        assert!(result.resumed.is_empty());
     }
 }
