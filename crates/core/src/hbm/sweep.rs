@@ -460,7 +460,7 @@ mod tests {
     #[allow(clippy::type_complexity)]
     fn resume(
         bridge: impl Fn(f64, usize) -> Result<Branch, SweepError>,
-        forward: impl Fn(f64) -> Branch,
+        forward: impl Fn(f64) -> Result<Branch, ContinuationError>,
     ) -> (Branch, Vec<(f64, f64, f64)>, Vec<(f64, f64)>) {
         let options = Options { max_step: 0.5, ..Options::default() };
         let (mut bridges, mut rests) = (Vec::new(), Vec::new());
@@ -477,7 +477,7 @@ mod tests {
             },
             |_, guess, from| {
                 rests.push((guess[0], from));
-                Ok(forward(from))
+                forward(from)
             },
         );
         (result, bridges, rests)
@@ -492,7 +492,7 @@ mod tests {
     fn a_stopped_sweep_goes_on_from_the_bridge_point_next_to_the_stop() {
         let (result, bridges, rests) = resume(
             |from, _| bridge_to(from, 2.0),
-            |from| with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd),
+            |from| Ok(with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd)),
         );
         // The nearest restart, 1/16 of the largest step (0.5 of the band, 9) beyond the stop,
         // from the stop's solution, followed back to the stop.
@@ -525,7 +525,7 @@ mod tests {
                 2 => Ok(with(&[(from, from), (2.5, 2.5)], stopped())),
                 _ => bridge_to(from, 2.0),
             },
-            |from| with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd),
+            |from| Ok(with(&[(from, from), (10.0, 10.0)], TerminationReason::ReachedEnd)),
         );
         assert_eq!(bridges.len(), 3);
         assert_eq!(result.resumed, [Resumption { stopped_at: 2.0, restarted_at: 6.5 }]);
@@ -536,7 +536,7 @@ mod tests {
     fn a_branch_that_keeps_stopping_is_resumed_a_bounded_number_of_times() {
         // Every rest stops again just after its start.
         let (result, bridges, rests) =
-            resume(|from, _| bridge_to(from, 2.0), |from| with(&[(from, from), (from + 0.01, 2.0)], stopped()));
+            resume(|from, _| bridge_to(from, 2.0), |from| Ok(with(&[(from, from), (from + 0.01, 2.0)], stopped())));
         assert_eq!(rests.len(), MAX_RESUMPTIONS);
         assert_eq!(bridges.len(), MAX_RESUMPTIONS);
         assert_eq!(result.resumed.len(), MAX_RESUMPTIONS);
@@ -545,17 +545,11 @@ mod tests {
 
     #[test]
     fn a_rest_that_fails_to_start_leaves_the_stop_with_its_points() {
-        let options = Options { max_step: 0.5, ..Options::default() };
-        let branch = with(&[(1.0, 1.0), (2.0, 2.0)], stopped());
-        let result = resumed_past_stops(
-            &mut (),
-            branch,
-            10.0,
-            &options,
-            9.0,
-            |_, _, from, _| bridge_to(from, 2.0),
-            |_, _, _| Err(ContinuationError::WrongGuessLength { len: 0, expected: 1 }),
+        let (result, _, rests) = resume(
+            |from, _| bridge_to(from, 2.0),
+            |_| Err(ContinuationError::WrongGuessLength { len: 0, expected: 1 }),
         );
+        assert_eq!(rests.len(), 1);
         assert_eq!(result.points.len(), 2);
         assert_eq!(result.termination, stopped());
         assert!(result.resumed.is_empty());
