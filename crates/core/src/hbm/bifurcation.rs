@@ -8,7 +8,9 @@
 //!   exponents crosses the imaginary axis between two accepted points: a **period doubling**
 //!   when its imaginary part is ±Ω/2 (a multiplier through −1), a **Neimark-Sacker**
 //!   bifurcation otherwise (the response becomes quasi-periodic), located by [`zero_along`] on
-//!   the leading exponent's real part, along the branch.
+//!   the crossing exponent's real part, along the branch. The unstable exponents are counted
+//!   by kind, so that a crossing is found on a branch already unstable too
+//!   ([`floquet_bifurcations`]).
 //!
 //! A real exponent crosses zero exactly where the balance's Jacobian is singular. At s = 0
 //! (where the sliders' memory weights `e^{−sΔ}` are 1) Hill's matrix is the Jacobian of the
@@ -248,10 +250,30 @@ pub fn folds_and_branch_points<P: Problem>(
 }
 
 /// The period doublings and Neimark-Sacker bifurcations between consecutive points of a
-/// frequency-sweep branch at `level`: where the stable flag changes and the leading exponent
-/// of the unstable point is complex (a real one is a fold or a branch point, found by
-/// [`folds_and_branch_points`]), given each point's stability, each located along the branch to
-/// `tolerance` on the chord between its two points.
+/// frequency-sweep branch at `level`, given each point's stability, each located along the
+/// branch to `tolerance` on the chord between its two points.
+///
+/// **Counted by kind, not by the stable flag.** At each point the exponents with a positive
+/// real part are counted by kind ([`UnstableCounts`]): real ones, complex pairs (a pair once,
+/// [`CrossingKind::ComplexPair`]) and multipliers on the negative real axis
+/// ([`CrossingKind::HalfFrequency`]). Where between two points the count of a kind changes, one
+/// of its exponents may have crossed the imaginary axis, whatever the others do: a complex pair
+/// crossing while a real exponent is already positive (between the folds of a resonance, say)
+/// is a Neimark-Sacker bifurcation of a branch that was unstable already, which the stable flag,
+/// unstable on both sides, does not show. The count of a kind also changes where an unstable
+/// exponent changes kind without crossing (a complex pair meeting on the real axis and splitting
+/// into two real exponents there): then the count of another kind changes too. Where only one
+/// kind's count changes, the crossing is reported, located or not; where several change in one
+/// step (a fold and a crossing close together, or a change of kind), only a located zero of the
+/// crossing exponent's real part (to [`CROSSED`] of Ω) is. Real exponents are left to
+/// [`folds_and_branch_points`], which finds their crossings from the test functions (module
+/// documentation).
+///
+/// **Located on the crossing exponent.** With `k` exponents of the kind unstable at the point
+/// that has fewer, the one crossing is the `k`-th of that kind by real part (largest first): its
+/// real part, continuous along the branch (an order statistic of continuous functions), changes
+/// sign between the points, and [`zero_along`] finds its zero. On a stable branch (`k = 0`) it
+/// is the kind's leading exponent, as the stable flag's change showed before.
 pub fn floquet_bifurcations(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
@@ -263,44 +285,156 @@ pub fn floquet_bifurcations(
     let mut found = Vec::new();
     for i in 0..points.len().saturating_sub(1) {
         let (p0, p1) = (&points[i], &points[i + 1]);
-        let (s0, s1) = (is_stable(&stabilities[i], p0.lambda), is_stable(&stabilities[i + 1], p1.lambda));
-        if s0 == s1 {
-            continue;
-        }
-        let unstable = if s0 { &stabilities[i + 1] } else { &stabilities[i] };
-        let omega = p0.lambda.max(p1.lambda);
-        let im = unstable.leading().im.abs();
-        if im <= REAL * omega {
-            // A real exponent: a fold or a branch point, from the test functions.
-            continue;
-        }
-        let kind = if (im - 0.5 * omega).abs() <= REAL * omega {
-            BifurcationKind::PeriodDoubling
-        } else {
-            BifurcationKind::NeimarkSacker
-        };
-        let located = zero_along(&mut FrequencySweep { hbm, level }, [p0, p1], tolerance, |problem, x, w| {
-            let s = stability_at(problem.hbm, hill, x, w).map_err(|e| ProblemError::new(e.to_string()))?;
-            Ok(s.leading().re)
-        });
-        found.push(match located {
-            Ok(z) => {
-                let exponent =
-                    stability_at(hbm, hill, &z.x, z.lambda).map(|s| s.leading()).unwrap_or(unstable.leading());
-                Bifurcation { kind, omega: z.lambda, x: z.x, exponent: Some(exponent), after_point: i, located: true }
+        let (s0, s1) = (&stabilities[i], &stabilities[i + 1]);
+        let (c0, c1) = (UnstableCounts::of(s0, p0.lambda), UnstableCounts::of(s1, p1.lambda));
+        for kind in [CrossingKind::ComplexPair, CrossingKind::HalfFrequency] {
+            let (e0, e1) = (kind.exponents(s0, p0.lambda), kind.exponents(s1, p1.lambda));
+            let (n0, n1) = (c0.of_kind(kind), c1.of_kind(kind));
+            // The k-th of the kind must exist at both points: one that appears or disappears
+            // (changes kind) has not crossed the imaginary axis.
+            let k = n0.min(n1);
+            if n0 == n1 || k >= e0.len() || k >= e1.len() {
+                continue;
             }
-            Err(_) => Bifurcation {
-                kind,
-                omega: p1.lambda,
-                x: p1.x.clone(),
-                exponent: Some(unstable.leading()),
-                after_point: i,
-                located: false,
-            },
-        });
+            let alone = c0.differ_only_in(&c1, kind);
+            let unstable_end = if n1 > n0 { e1[k] } else { e0[k] };
+            let located = zero_along(&mut FrequencySweep { hbm, level }, [p0, p1], tolerance, |problem, x, w| {
+                let s = stability_at(problem.hbm, hill, x, w).map_err(|e| ProblemError::new(e.to_string()))?;
+                kind.exponents(&s, w)
+                    .get(k)
+                    .map(|s| s.re)
+                    .ok_or_else(|| ProblemError::new("the crossing exponent changed kind on the bracket"))
+            });
+            let bifurcation = match located {
+                Ok(z) => {
+                    let exponent = stability_at(hbm, hill, &z.x, z.lambda)
+                        .ok()
+                        .and_then(|s| kind.exponents(&s, z.lambda).get(k).copied())
+                        .unwrap_or(unstable_end);
+                    // With other kinds changing in the same step, only a zero of the exponent
+                    // itself: where an exponent changed kind, the k-th of the kind jumps and
+                    // the location ends on the jump, its real part far from zero.
+                    if !alone && exponent.re.abs() > CROSSED * z.lambda {
+                        continue;
+                    }
+                    Bifurcation {
+                        kind: kind.bifurcation(),
+                        omega: z.lambda,
+                        x: z.x,
+                        exponent: Some(exponent),
+                        after_point: i,
+                        located: true,
+                    }
+                }
+                Err(_) if alone => Bifurcation {
+                    kind: kind.bifurcation(),
+                    omega: p1.lambda,
+                    x: p1.x.clone(),
+                    exponent: Some(unstable_end),
+                    after_point: i,
+                    located: false,
+                },
+                Err(_) => continue,
+            };
+            found.push(bifurcation);
+        }
     }
     found
 }
+
+/// The kinds of Floquet exponent whose crossings [`floquet_bifurcations`] reports, by their
+/// imaginary part at fundamental Ω (a multiplier `e^{sT}`, `T = 2π/Ω`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CrossingKind {
+    /// A complex pair `s, s̄` with `0 < |Im s| < Ω/2` (multipliers `e^{±iθ}`-like): a
+    /// Neimark-Sacker bifurcation when it crosses.
+    ComplexPair,
+    /// `|Im s| = Ω/2`, a multiplier on the negative real axis: a period doubling when it
+    /// crosses (through −1).
+    HalfFrequency,
+}
+
+impl CrossingKind {
+    /// The bifurcation a crossing of this kind is.
+    pub fn bifurcation(&self) -> BifurcationKind {
+        match self {
+            CrossingKind::ComplexPair => BifurcationKind::NeimarkSacker,
+            CrossingKind::HalfFrequency => BifurcationKind::PeriodDoubling,
+        }
+    }
+
+    /// The exponents of this kind among `stability`'s at Ω, one per multiplier, largest real
+    /// part first. A complex pair is represented by its member with `Im s > 0`. A multiplier on
+    /// the negative real axis appears in Hill's spectrum as `s + iΩ/2` and `s − iΩ/2` (the same
+    /// multiplier), which tie in the sorting of the physical exponents: exponents of this kind
+    /// with the same real part (to [`EXPONENT_TOLERANCE`]) count once. (Where two such
+    /// multipliers exist and the sorting keeps both representations of one, the other is not
+    /// among the physical exponents at all, and not counted.)
+    pub fn exponents(&self, stability: &Stability, omega: f64) -> Vec<c64> {
+        let mut found: Vec<c64> = Vec::new();
+        for &s in &stability.exponents {
+            let im = s.im.abs();
+            let half = (im - 0.5 * omega).abs() <= REAL * omega;
+            match self {
+                CrossingKind::ComplexPair if s.im > REAL * omega && !half => found.push(s),
+                CrossingKind::HalfFrequency if half => {
+                    if !found.iter().any(|f| (f.re - s.re).abs() <= EXPONENT_TOLERANCE * omega) {
+                        found.push(c64::new(s.re, im));
+                    }
+                }
+                _ => {}
+            }
+        }
+        found.sort_by(|a, b| b.re.total_cmp(&a.re));
+        found
+    }
+}
+
+/// The number of exponents with a positive real part (to [`EXPONENT_TOLERANCE`] of Ω), by
+/// kind: real ones, complex pairs (a pair once), multipliers on the negative real axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnstableCounts {
+    pub real: usize,
+    pub complex_pairs: usize,
+    pub half_frequency: usize,
+}
+
+impl UnstableCounts {
+    /// The counts of `stability`'s exponents at Ω.
+    pub fn of(stability: &Stability, omega: f64) -> Self {
+        let positive = |s: &c64| s.re > EXPONENT_TOLERANCE * omega;
+        let unstable = |kind: CrossingKind| kind.exponents(stability, omega).iter().filter(|s| positive(s)).count();
+        UnstableCounts {
+            real: stability.exponents.iter().filter(|s| s.im.abs() <= REAL * omega && positive(s)).count(),
+            complex_pairs: unstable(CrossingKind::ComplexPair),
+            half_frequency: unstable(CrossingKind::HalfFrequency),
+        }
+    }
+
+    /// The count of one kind.
+    pub fn of_kind(&self, kind: CrossingKind) -> usize {
+        match kind {
+            CrossingKind::ComplexPair => self.complex_pairs,
+            CrossingKind::HalfFrequency => self.half_frequency,
+        }
+    }
+
+    /// Do `self` and `other` differ in `kind`'s count only?
+    fn differ_only_in(&self, other: &Self, kind: CrossingKind) -> bool {
+        let others_equal = match kind {
+            CrossingKind::ComplexPair => self.real == other.real && self.half_frequency == other.half_frequency,
+            CrossingKind::HalfFrequency => self.real == other.real && self.complex_pairs == other.complex_pairs,
+        };
+        others_equal && self.of_kind(kind) != other.of_kind(kind)
+    }
+}
+
+/// A located crossing whose exponent's real part is within this fraction of Ω of zero is one.
+/// The exponent is located to ~1e-10 of a step along the branch, where it moves by a fraction
+/// of Ω per unit of Ω: its real part there is ~1e-13 Ω (measured below 2e-13 on the pair of
+/// oscillators of `tests/stability_neimark_sacker.rs`), where an exponent that changed kind
+/// jumps by a damping rate, ~1e-3 Ω and more.
+const CROSSED: f64 = 1e-6;
 
 /// Imaginary parts within this fraction of Ω of 0 (a real exponent) or of Ω/2 (a multiplier
 /// through −1) count as those: the exponents are accurate to ~1e-12 Ω (Hill's eigenproblem),

@@ -30,7 +30,7 @@ pub mod sweep;
 
 pub use bifurcation::{
     floquet_bifurcations, folds_and_branch_points, stability_at, stability_at_last_evaluation,
-    stability_by_eigenproblems, Bifurcation, BifurcationKind, BranchStabilityError,
+    stability_by_eigenproblems, Bifurcation, BifurcationKind, BranchStabilityError, CrossingKind, UnstableCounts,
 };
 pub use condensed::{CondensedHbm, HbmError, HbmSettings, Jacobians};
 pub use element_aft::{AftError, ElementAft};
