@@ -49,7 +49,7 @@ fn oscillators(k: Mat<f64>) -> NonlinearModel {
         Matrix::Dense(Mat::identity(n, n)),
         Matrix::Dense(k),
         Damping::Rayleigh { alpha: ALPHA, beta: 0.0 },
-        (0..n).map(|i| DofLabel::named(&format!("x{i}"))).collect(),
+        (0..n).map(|i| DofLabel::named(format!("x{i}"))).collect(),
         vec![],
     )
     .unwrap();

@@ -377,10 +377,10 @@ impl CrossingKind {
             let half = (im - 0.5 * omega).abs() <= REAL * omega;
             match self {
                 CrossingKind::ComplexPair if s.im > REAL * omega && !half => found.push(s),
-                CrossingKind::HalfFrequency if half => {
-                    if !found.iter().any(|f| (f.re - s.re).abs() <= EXPONENT_TOLERANCE * omega) {
-                        found.push(c64::new(s.re, im));
-                    }
+                CrossingKind::HalfFrequency
+                    if half && !found.iter().any(|f| (f.re - s.re).abs() <= EXPONENT_TOLERANCE * omega) =>
+                {
+                    found.push(c64::new(s.re, im))
                 }
                 _ => {}
             }
