@@ -27,7 +27,7 @@ use super::joint_forces::JointForces;
 use std::sync::Arc;
 
 use super::receptance::{HarmonicReceptance, Receptance};
-use super::structured::StructuredJacobian;
+use super::structured::{ReducedFactor, StructuredJacobian};
 use crate::model::{ModelError, NonlinearModel};
 
 /// Numerical settings of the harmonic balance.
@@ -88,6 +88,9 @@ pub struct CondensedHbm<'m> {
     product: Vec<c64>,
     /// `∂R/∂x` of the last [`Self::evaluate_factored`].
     factored: Option<StructuredJacobian>,
+    /// The last factored reduced system of the structured Jacobians, the next one's
+    /// preconditioner ([`super::structured`]).
+    reduced_factor: Option<Arc<ReducedFactor>>,
     /// Solve Newton systems by [`StructuredJacobian`] rather than a dense LU.
     by_structure: bool,
     /// Every element is a slider, whose Jacobian follows from a residual evaluation's slip
@@ -149,6 +152,7 @@ impl<'m> CondensedHbm<'m> {
             amplitudes: vec![c64::new(0.0, 0.0); q],
             product: vec![c64::new(0.0, 0.0); q],
             factored: None,
+            reduced_factor: None,
             by_structure: q * plan.n_coeffs() >= FACTOR_BY_STRUCTURE_FROM,
             sliders_only: model.elements.iter().all(|e| {
                 let law = e.law.as_ref();
@@ -348,11 +352,19 @@ impl<'m> CondensedHbm<'m> {
         domega: Option<&mut [f64]>,
         dlevel: Option<&mut [f64]>,
     ) -> Result<bool, HbmError> {
-        self.factored = None;
+        if let Some(factor) = self.factored.take().and_then(|f| f.reduced_factor()) {
+            self.reduced_factor = Some(factor);
+        }
         self.residual(x, omega, level, residual, true)?;
         self.parameter_derivatives(level, domega, dlevel);
-        self.factored =
-            StructuredJacobian::factor(self.q, &self.h0, &self.harmonic, &self.joints.offsets, &self.joints.elem_jac);
+        self.factored = StructuredJacobian::factor(
+            self.q,
+            &self.h0,
+            &self.harmonic,
+            &self.joints.offsets,
+            &self.joints.elem_jac,
+            self.reduced_factor.clone(),
+        );
         Ok(self.factored.is_some())
     }
 
