@@ -22,7 +22,7 @@ use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use rayon::prelude::*;
 
-use crate::output::{JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
+use crate::output::{ElementRecord, JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
 use crate::records::{FrfSet, TimeRecords};
 use crate::study::PlotFormat;
 
@@ -493,10 +493,16 @@ pub fn plot_joint_sides(path: &Path, snapshot: &SnapshotResult, sides: &JointSid
 /// Per level `i`: the harmonics of each output (`harmonics_level<i>_<out>`), and, at the point
 /// with time data where the first output's FRF is largest (the resonance, as in the paper's
 /// Fig. 17), each element's hysteresis loop (`loop_level<i>_<el>`) and slider velocity
-/// (`slider_level<i>_<el>`). Returns the files written.
+/// (`slider_level<i>_<el>`): of every element direction when there are at most
+/// [`DETAILED_ELEMENTS`], else of the [`DETAILED_ELEMENTS`] that dissipate most there (a
+/// contact patch has hundreds; all of them are in the time data). Returns the files written.
 pub fn plot_level_details(dir: &Path, levels: &[LevelResult], format: PlotFormat) -> Result<Vec<PathBuf>, OutputError> {
     draw_all(level_details(dir, levels, format))
 }
+
+/// Element directions whose loops and slider velocities [`plot_level_details`] draws per level
+/// at most: the four joints of the paper's Harmony study twice over.
+pub const DETAILED_ELEMENTS: usize = 8;
 
 /// The plots of [`plot_level_details`].
 fn level_details<'a>(dir: &Path, levels: &'a [LevelResult], format: PlotFormat) -> Vec<PlotJob<'a>> {
@@ -517,7 +523,13 @@ fn level_details<'a>(dir: &Path, levels: &'a [LevelResult], format: PlotFormat) 
                 amplitude(a).total_cmp(&amplitude(b))
             });
         let Some(point) = resonance else { continue };
-        for e in point.elements.iter().filter(|e| !e.loop_u.is_empty()) {
+        let mut detailed: Vec<&ElementRecord> = point.elements.iter().filter(|e| !e.loop_u.is_empty()).collect();
+        if detailed.len() > DETAILED_ELEMENTS {
+            // Stable: among equal energies (a stuck patch) the first in the study's order.
+            detailed.sort_by(|a, b| b.energy_j.total_cmp(&a.energy_j));
+            detailed.truncate(DETAILED_ELEMENTS);
+        }
+        for e in detailed {
             let (level_n, element) = (level.level_n, e.name.as_str());
             let path = dir.join(format!("loop_level{i}_{element}.{ext}"));
             jobs.push(PlotJob::new(path, move |path| plot_hysteresis(path, level_n, point, element)));
