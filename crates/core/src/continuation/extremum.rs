@@ -20,11 +20,11 @@ use std::collections::BTreeMap;
 use super::linear::Workspace;
 use super::{Point, Problem, ProblemError};
 
-/// A point of the bracket: its scaled variables, converged to round-off (`exact`) or to
-/// `SCAN_PRECISION`.
+/// A point of the bracket: its scaled variables, and the bound on Newton's next update where
+/// it was accepted (0: converged to round-off).
 struct Solved {
     z: Vec<f64>,
-    exact: bool,
+    precision: f64,
 }
 
 /// The located maximum.
@@ -63,9 +63,12 @@ const ROUND_OFF: f64 = 1e-13;
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
 const CANDIDATE: f64 = 2e-4;
 /// A point of the scan is accepted once Newton's next update would move it by at most this
-/// (scaled variables: of the bracket's x and λ spans): its value then errs by ~1e-9 of itself,
-/// far below the 1e-5 by which arcs differ, and its solve saves the Jacobian and evaluation
-/// that only polish it to round-off. The located point itself is always converged to round-off.
+/// (scaled variables: of the bracket's x and λ spans), Brent's points once it would move them
+/// by 1e-4 of the search's tolerance if that is less (the same at the tolerance of 1e-5 that
+/// peaks are located to). A value then errs by ~1e-10 of itself (measured against round-off on
+/// Table 6), far below the 1e-5 by which arcs differ and the ~1e-8 a corner's slope gives over
+/// the tolerance; the solve saves the Jacobian and evaluation that would only polish it (most
+/// of the scan's points on Table 6). The located point itself is converged to round-off.
 const SCAN_PRECISION: f64 = 1e-9;
 /// A side of the scan stops after two consecutive points this fraction below the best: twice
 /// CANDIDATE, so that an arc whose top is within CANDIDATE of the best (its scanned points
@@ -125,23 +128,29 @@ impl Bracket {
         let path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
         // The middle point is the continuation's, converged to its tolerance (1e-10 of the
         // residual scale by default): as good as a scan's point, and its own value.
-        let solved = BTreeMap::from([(sm.to_bits(), Some(Solved { z: zm.clone(), exact: false }))]);
+        let solved = BTreeMap::from([(sm.to_bits(), Some(Solved { z: zm.clone(), precision: SCAN_PRECISION }))]);
         Ok(Bracket { z0, zm, z1, sm, path, solved, solves: 0 })
     }
 
-    /// The point at `s` (scaled), solved once (to round-off if `exact`, else to
-    /// `SCAN_PRECISION`): from the line through the nearest points solved on either side, or
+    /// The point at `s` (scaled) and its precision, solved once to `precision` (0: to
+    /// round-off; see [`ChordPath::solve`]), further if asked for more later: from the line through the nearest points solved on either side, or
     /// the two nearest on one side, if they are near (the scan's neighbours, Brent's steps: one
     /// or two Newton iterations), else from the parabola through the three points. `None` if
     /// it cannot be solved there.
-    fn point<P: Problem>(&mut self, problem: &mut P, s: f64, exact: bool) -> Result<Option<&[f64]>, ProblemError> {
+    fn point<P: Problem>(
+        &mut self,
+        problem: &mut P,
+        s: f64,
+        precision: f64,
+    ) -> Result<Option<(&[f64], f64)>, ProblemError> {
         let key = s.to_bits();
-        if let Some(Some(point)) = self.solved.get_mut(&key).filter(|p| exact && p.as_ref().is_some_and(|p| !p.exact)) {
-            // A scan's point wanted to round-off: Newton goes on from it.
+        let wanted = |p: &Option<Solved>| p.as_ref().is_some_and(|p| p.precision > precision);
+        if let Some(Some(point)) = self.solved.get_mut(&key).filter(|p| wanted(p)) {
+            // Wanted more precise than it was solved: Newton goes on from it.
             self.solves += 1;
             let mut z = std::mem::take(&mut point.z);
-            let solved = self.path.solve(problem, s, &mut z, 0.0)?;
-            self.solved.insert(key, solved.map(|exact| Solved { z, exact }));
+            let solved = self.path.solve(problem, s, &mut z, precision)?;
+            self.solved.insert(key, solved.map(|exact| Solved { z, precision: if exact { 0.0 } else { precision } }));
         }
         if !self.solved.contains_key(&key) {
             let n = self.path.n;
@@ -192,10 +201,10 @@ impl Bracket {
                 }
             }
             self.solves += 1;
-            let solved = self.path.solve(problem, s, &mut z, if exact { 0.0 } else { SCAN_PRECISION })?;
-            self.solved.insert(key, solved.map(|exact| Solved { z, exact }));
+            let solved = self.path.solve(problem, s, &mut z, precision)?;
+            self.solved.insert(key, solved.map(|exact| Solved { z, precision: if exact { 0.0 } else { precision } }));
         }
-        Ok(self.solved[&key].as_ref().map(|p| p.z.as_slice()))
+        Ok(self.solved[&key].as_ref().map(|p| (p.z.as_slice(), p.precision)))
     }
 
     /// The maximum of `quantity(problem, x, λ)` between the bracket's ends, to `tolerance` on
@@ -217,21 +226,21 @@ impl Bracket {
             quantity(problem, &x, z[n] * lambda_scale)
         };
         let (f0, f1) = (at_end(&self.z0)?, at_end(&self.z1)?);
-        // The quantity at s, kept by `s` with whether its point is converged to round-off.
-        let mut values: BTreeMap<u64, (f64, bool)> = BTreeMap::new();
+        // The quantity at s, kept by `s` with the precision of its point.
+        let mut values: BTreeMap<u64, (f64, f64)> = BTreeMap::new();
         let mut value_at = |bracket: &mut Bracket,
                             problem: &mut P,
-                            values: &mut BTreeMap<u64, (f64, bool)>,
+                            values: &mut BTreeMap<u64, (f64, f64)>,
                             s: f64,
-                            exact: bool|
+                            precision: f64|
          -> Result<f64, ProblemError> {
-            let Some(z) = bracket.point(problem, s, exact)? else {
+            let Some((z, precision)) = bracket.point(problem, s, precision)? else {
                 // A point that cannot be solved is not the maximum.
                 return Ok(f64::NEG_INFINITY);
             };
             let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
             let value = quantity(problem, &x, z[n] * lambda_scale)?;
-            values.insert(s.to_bits(), (value, exact));
+            values.insert(s.to_bits(), (value, precision));
             Ok(value)
         };
 
@@ -241,7 +250,7 @@ impl Bracket {
         // points place the envelope's vertex (a parabola through them); a scan on a lattice
         // finer than the arcs around it finds the arcs near the top, and Brent's method the
         // maximum of each arc whose scanned best is near the best (the highest is kept).
-        let fm = value_at(self, problem, &mut values, sm, false)?;
+        let fm = value_at(self, problem, &mut values, sm, SCAN_PRECISION)?;
         // Vertex of the parabola through (0, f0), (sm, fm), (1, f1).
         let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
         let denominator = d0 - d1;
@@ -268,7 +277,7 @@ impl Bracket {
             let mut k = if side == 1 { centre } else { centre - 1 };
             while (first..=last).contains(&k) && low < 2 {
                 if lattice(k) > 0.0 && lattice(k) < 1.0 {
-                    let value = value_at(self, problem, &mut values, lattice(k), false)?;
+                    let value = value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?;
                     samples.push((lattice(k), value));
                     top = top.max(value);
                     low = if value < top - DROP * top.abs() { low + 1 } else { 0 };
@@ -296,7 +305,7 @@ impl Bracket {
             } else {
                 break;
             };
-            samples.push((lattice(k), value_at(self, problem, &mut values, lattice(k), false)?));
+            samples.push((lattice(k), value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?));
         }
         let top = samples.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
         if top.is_finite() {
@@ -314,22 +323,25 @@ impl Bracket {
                 })
                 .collect();
             candidates.sort_by(|&a, &b| samples[b].1.total_cmp(&samples[a].1));
+            // Brent's points to a precision far below its tolerance, so that its comparisons are
+            // those of points converged to round-off.
+            let refined = (1e-4 * tolerance).min(SCAN_PRECISION);
             for j in candidates {
                 brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| {
-                    value_at(self, problem, &mut values, s, false)
+                    value_at(self, problem, &mut values, s, refined)
                 })?;
             }
         }
         // The best point, converged to round-off (a scan's point is solved further if it is
         // the best, and may then be overtaken).
         let (value, s) = loop {
-            let Some((&key, &(value, exact))) = values.iter().max_by(|a, b| a.1 .0.total_cmp(&b.1 .0)) else {
+            let Some((&key, &(value, precision))) = values.iter().max_by(|a, b| a.1 .0.total_cmp(&b.1 .0)) else {
                 break (f64::NEG_INFINITY, sm);
             };
-            if exact || !value.is_finite() {
+            if precision == 0.0 || !value.is_finite() {
                 break (value, f64::from_bits(key));
             }
-            value_at(self, problem, &mut values, f64::from_bits(key), true)?;
+            value_at(self, problem, &mut values, f64::from_bits(key), 0.0)?;
         };
         if !value.is_finite() {
             return Err(ProblemError::new("no point of the bracket could be solved"));
