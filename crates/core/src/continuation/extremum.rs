@@ -20,6 +20,13 @@ use std::collections::BTreeMap;
 use super::linear::Workspace;
 use super::{Point, Problem, ProblemError};
 
+/// A point of the bracket: its scaled variables, and the bound on Newton's next update where
+/// it was accepted (0: converged to round-off).
+struct Solved {
+    z: Vec<f64>,
+    precision: f64,
+}
+
 /// The located maximum.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Extremum {
@@ -55,6 +62,14 @@ const ROUND_OFF: f64 = 1e-13;
 /// of the best. The tops of a friction peak's arcs differ by 1e-5 to 1e-4 near the maximum, a
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
 const CANDIDATE: f64 = 2e-4;
+/// A point of the scan is accepted once Newton's next update would move it by at most this
+/// (scaled variables: of the bracket's x and λ spans), Brent's points once it would move them
+/// by 1e-4 of the search's tolerance if that is less (the same at the tolerance of 1e-5 that
+/// peaks are located to). A value then errs by ~1e-10 of itself (measured against round-off on
+/// Table 6), far below the 1e-5 by which arcs differ and the ~1e-8 a corner's slope gives over
+/// the tolerance; the solve saves the Jacobian and evaluation that would only polish it (most
+/// of the scan's points on Table 6). The located point itself is converged to round-off.
+const SCAN_PRECISION: f64 = 1e-9;
 /// A side of the scan stops after two consecutive points this fraction below the best: twice
 /// CANDIDATE, so that an arc whose top is within CANDIDATE of the best (its scanned points
 /// within CANDIDATE and ~4e-5 of it) is never left out.
@@ -87,7 +102,7 @@ pub struct Bracket {
     path: ChordPath,
     /// Points solved so far, by `s` (bit pattern: lattice points are computed identically):
     /// `None` where the branch could not be solved.
-    solved: BTreeMap<u64, Option<Vec<f64>>>,
+    solved: BTreeMap<u64, Option<Solved>>,
     /// Points solved on the branch so far.
     pub solves: usize,
 }
@@ -111,15 +126,32 @@ impl Bracket {
             return Err(ProblemError::new(format!("the middle point (s = {sm}) is not between the bracket's ends")));
         }
         let path = ChordPath::new(problem, &z0, &z1, x_scale, lambda_scale);
-        Ok(Bracket { z0, zm, z1, sm, path, solved: BTreeMap::new(), solves: 0 })
+        // The middle point is the continuation's, converged to its tolerance (1e-10 of the
+        // residual scale by default): as good as a scan's point, and its own value.
+        let solved = BTreeMap::from([(sm.to_bits(), Some(Solved { z: zm.clone(), precision: SCAN_PRECISION }))]);
+        Ok(Bracket { z0, zm, z1, sm, path, solved, solves: 0 })
     }
 
-    /// The point at `s` (scaled), solved once: from the line through the nearest points
-    /// solved on either side, or the two nearest on one side, if they are near (the scan's
-    /// neighbours, Brent's steps: one or two Newton iterations), else from the parabola
-    /// through the three points. `None` if it cannot be solved there.
-    fn point<P: Problem>(&mut self, problem: &mut P, s: f64) -> Result<Option<&[f64]>, ProblemError> {
+    /// The point at `s` (scaled) and its precision, solved once to `precision` (0: to
+    /// round-off; see [`ChordPath::solve`]), further if asked for more later: from the line through the nearest points solved on either side, or
+    /// the two nearest on one side, if they are near (the scan's neighbours, Brent's steps: one
+    /// or two Newton iterations), else from the parabola through the three points. `None` if
+    /// it cannot be solved there.
+    fn point<P: Problem>(
+        &mut self,
+        problem: &mut P,
+        s: f64,
+        precision: f64,
+    ) -> Result<Option<(&[f64], f64)>, ProblemError> {
         let key = s.to_bits();
+        let wanted = |p: &Option<Solved>| p.as_ref().is_some_and(|p| p.precision > precision);
+        if let Some(Some(point)) = self.solved.get_mut(&key).filter(|p| wanted(p)) {
+            // Wanted more precise than it was solved: Newton goes on from it.
+            self.solves += 1;
+            let mut z = std::mem::take(&mut point.z);
+            let solved = self.path.solve(problem, s, &mut z, precision)?;
+            self.solved.insert(key, solved.map(|exact| Solved { z, precision: if exact { 0.0 } else { precision } }));
+        }
         if !self.solved.contains_key(&key) {
             let n = self.path.n;
             let mut z = vec![0.0; n + 1];
@@ -129,14 +161,14 @@ impl Bracket {
                 .solved
                 .range(..key)
                 .rev()
-                .filter_map(|(k, z)| Some((f64::from_bits(*k), z.as_ref()?)))
+                .filter_map(|(k, p)| Some((f64::from_bits(*k), &p.as_ref()?.z)))
                 .take_while(|(t, _)| near(*t))
                 .take(2)
                 .collect();
             let above: Vec<(f64, &Vec<f64>)> = self
                 .solved
                 .range(key..)
-                .filter_map(|(k, z)| Some((f64::from_bits(*k), z.as_ref()?)))
+                .filter_map(|(k, p)| Some((f64::from_bits(*k), &p.as_ref()?.z)))
                 .take_while(|(t, _)| near(*t))
                 .take(2)
                 .collect();
@@ -169,10 +201,10 @@ impl Bracket {
                 }
             }
             self.solves += 1;
-            let solved = self.path.solve(problem, s, &mut z)?;
-            self.solved.insert(key, solved.then_some(z));
+            let solved = self.path.solve(problem, s, &mut z, precision)?;
+            self.solved.insert(key, solved.map(|exact| Solved { z, precision: if exact { 0.0 } else { precision } }));
         }
-        Ok(self.solved[&key].as_deref())
+        Ok(self.solved[&key].as_ref().map(|p| (p.z.as_slice(), p.precision)))
     }
 
     /// The maximum of `quantity(problem, x, λ)` between the bracket's ends, to `tolerance` on
@@ -194,18 +226,21 @@ impl Bracket {
             quantity(problem, &x, z[n] * lambda_scale)
         };
         let (f0, f1) = (at_end(&self.z0)?, at_end(&self.z1)?);
-        // The quantity at s; the best point so far is kept.
-        let mut best = (f64::NEG_INFINITY, self.zm.clone());
-        let mut value_at = |bracket: &mut Bracket, problem: &mut P, s: f64| -> Result<f64, ProblemError> {
-            let Some(z) = bracket.point(problem, s)? else {
+        // The quantity at s, kept by `s` with the precision of its point.
+        let mut values: BTreeMap<u64, (f64, f64)> = BTreeMap::new();
+        let mut value_at = |bracket: &mut Bracket,
+                            problem: &mut P,
+                            values: &mut BTreeMap<u64, (f64, f64)>,
+                            s: f64,
+                            precision: f64|
+         -> Result<f64, ProblemError> {
+            let Some((z, precision)) = bracket.point(problem, s, precision)? else {
                 // A point that cannot be solved is not the maximum.
                 return Ok(f64::NEG_INFINITY);
             };
             let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
             let value = quantity(problem, &x, z[n] * lambda_scale)?;
-            if value > best.0 {
-                best = (value, z.to_vec());
-            }
+            values.insert(s.to_bits(), (value, precision));
             Ok(value)
         };
 
@@ -215,7 +250,7 @@ impl Bracket {
         // points place the envelope's vertex (a parabola through them); a scan on a lattice
         // finer than the arcs around it finds the arcs near the top, and Brent's method the
         // maximum of each arc whose scanned best is near the best (the highest is kept).
-        let fm = value_at(self, problem, sm)?;
+        let fm = value_at(self, problem, &mut values, sm, SCAN_PRECISION)?;
         // Vertex of the parabola through (0, f0), (sm, fm), (1, f1).
         let (d0, d1) = (sm * (fm - f1), (sm - 1.0) * (fm - f0));
         let denominator = d0 - d1;
@@ -242,7 +277,7 @@ impl Bracket {
             let mut k = if side == 1 { centre } else { centre - 1 };
             while (first..=last).contains(&k) && low < 2 {
                 if lattice(k) > 0.0 && lattice(k) < 1.0 {
-                    let value = value_at(self, problem, lattice(k))?;
+                    let value = value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?;
                     samples.push((lattice(k), value));
                     top = top.max(value);
                     low = if value < top - DROP * top.abs() { low + 1 } else { 0 };
@@ -270,7 +305,7 @@ impl Bracket {
             } else {
                 break;
             };
-            samples.push((lattice(k), value_at(self, problem, lattice(k))?));
+            samples.push((lattice(k), value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?));
         }
         let top = samples.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
         if top.is_finite() {
@@ -288,16 +323,30 @@ impl Bracket {
                 })
                 .collect();
             candidates.sort_by(|&a, &b| samples[b].1.total_cmp(&samples[a].1));
+            // Brent's points to a precision far below its tolerance, so that its comparisons are
+            // those of points converged to round-off.
+            let refined = (1e-4 * tolerance).min(SCAN_PRECISION);
             for j in candidates {
                 brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| {
-                    value_at(self, problem, s)
+                    value_at(self, problem, &mut values, s, refined)
                 })?;
             }
         }
-        let (value, best_z) = best;
+        // The best point, converged to round-off (a scan's point is solved further if it is
+        // the best, and may then be overtaken).
+        let (value, s) = loop {
+            let Some((&key, &(value, precision))) = values.iter().max_by(|a, b| a.1 .0.total_cmp(&b.1 .0)) else {
+                break (f64::NEG_INFINITY, sm);
+            };
+            if precision == 0.0 || !value.is_finite() {
+                break (value, f64::from_bits(key));
+            }
+            value_at(self, problem, &mut values, f64::from_bits(key), 0.0)?;
+        };
         if !value.is_finite() {
             return Err(ProblemError::new("no point of the bracket could be solved"));
         }
+        let best_z = &self.solved[&s.to_bits()].as_ref().expect("the best point was solved").z;
         Ok(Extremum {
             x: best_z[..n].iter().map(|v| v * x_scale).collect(),
             lambda: best_z[n] * lambda_scale,
@@ -360,7 +409,7 @@ pub fn zero_along<P: Problem>(
                 z[i] = (1.0 - w) * a.1[i] + w * b.1[i];
             }
             solves += 1;
-            solved = path.solve(problem, s, &mut z)?;
+            solved = path.solve(problem, s, &mut z, 0.0)?.is_some();
             if solved {
                 break;
             }
@@ -426,9 +475,17 @@ impl ChordPath {
         }
     }
 
-    /// Solve the point at `s` from the guess in `z`, converged to round-off (Newton until the
-    /// scaled update stops decreasing), into `z`. False if it cannot be solved there.
-    fn solve<P: Problem>(&mut self, problem: &mut P, s: f64, z: &mut [f64]) -> Result<bool, ProblemError> {
+    /// Solve the point at `s` from the guess in `z`, into `z`: converged to round-off (Newton
+    /// until the scaled update stops decreasing), or, if `early` is positive, once Newton's next
+    /// update is at most `early`, left where it was last evaluated. `Some(true)` if converged
+    /// to round-off, `Some(false)` if accepted early, `None` if it cannot be solved there.
+    fn solve<P: Problem>(
+        &mut self,
+        problem: &mut P,
+        s: f64,
+        z: &mut [f64],
+        early: f64,
+    ) -> Result<Option<bool>, ProblemError> {
         let n = self.n;
         let target: Vec<f64> = self.z0.iter().zip(&self.chord).map(|(a, c)| a + s * c).collect();
         let mut last_step = f64::INFINITY;
@@ -451,7 +508,23 @@ impl ChordPath {
             if evaluated.is_ok() && iteration > 0 {
                 let r = self.workspace.residual.iter().map(|v| v * v).sum::<f64>().sqrt();
                 if r <= ROUND_OFF * self.x.iter().map(|v| v * v).sum::<f64>().sqrt() {
-                    return Ok(true);
+                    return Ok(Some(true));
+                }
+                // Before the Jacobian is completed here, the next update estimated with the
+                // factors of the last one (a chord step: one back-substitution).
+                let workspace = &mut self.workspace;
+                if early > 0.0 && lazy && workspace.holds_bordered_factors() {
+                    let constraint: f64 =
+                        self.chord.iter().zip(z.iter().zip(&target)).map(|(c, (a, b))| c * (a - b)).sum();
+                    for i in 0..n {
+                        workspace.rhs[i] = -workspace.residual[i] / residual_scale;
+                    }
+                    workspace.rhs[n] = -constraint;
+                    if workspace.solve_with_bordered_factors()
+                        && workspace.rhs.iter().map(|d| d * d).sum::<f64>().sqrt() <= early
+                    {
+                        return Ok(Some(false));
+                    }
                 }
             }
             let evaluated = match evaluated {
@@ -461,7 +534,7 @@ impl ChordPath {
             match evaluated {
                 Ok(()) => {}
                 // A law that fails on this iterate: the point cannot be solved, not the search.
-                Err(e) if e.at_trial_iterate => return Ok(false),
+                Err(e) if e.at_trial_iterate => return Ok(None),
                 Err(e) => return Err(e),
             }
             let workspace = &mut self.workspace;
@@ -479,20 +552,24 @@ impl ChordPath {
             if !workspace.residual.iter().all(|r| r.is_finite())
                 || !workspace.solve_bordered(problem, self.x_scale, self.lambda_scale, residual_scale, &self.chord)
             {
-                return Ok(false);
+                return Ok(None);
             }
             let step = workspace.rhs.iter().map(|d| d * d).sum::<f64>().sqrt();
+            // Accurate enough as it is, where it was evaluated.
+            if step <= early {
+                return Ok(Some(false));
+            }
             for (zi, d) in z.iter_mut().zip(&workspace.rhs) {
                 *zi += d;
             }
             // Converged to round-off: the update is negligible, or small and no longer shrinking.
             if step <= 1e-14 * (1.0 + z.iter().map(|v| v * v).sum::<f64>().sqrt()) || (step < 1e-8 && step >= last_step)
             {
-                return Ok(true);
+                return Ok(Some(true));
             }
             last_step = step;
         }
-        Ok(false)
+        Ok(None)
     }
 }
 
