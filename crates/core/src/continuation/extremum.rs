@@ -235,7 +235,9 @@ impl Bracket {
                             precision: f64|
          -> Result<f64, ProblemError> {
             let Some((z, precision)) = bracket.point(problem, s, precision)? else {
-                // A point that cannot be solved is not the maximum.
+                // A point that cannot be solved is not the maximum (recorded so: a best point
+                // that fails to converge further gives way to the next).
+                values.insert(s.to_bits(), (f64::NEG_INFINITY, 0.0));
                 return Ok(f64::NEG_INFINITY);
             };
             let x: Vec<f64> = z[..n].iter().map(|v| v * x_scale).collect();
