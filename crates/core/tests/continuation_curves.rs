@@ -4,7 +4,8 @@
 
 use faer::MatMut;
 use stickslip_core::continuation::{
-    continue_branch, Branch, Options, Point, Predictor, Problem, ProblemError, Scales, Silent, TerminationReason,
+    continue_branch, Branch, Options, Point, Predictor, Problem, ProblemError, ProgressOverWhole, Scales, Silent,
+    TerminationReason,
 };
 
 /// x² + λ² = 1.
@@ -508,4 +509,30 @@ fn a_failure_at_a_trial_iterate_rejects_the_step_instead_of_ending_the_branch() 
         }
         other => panic!("expected ProblemError, got {other:?}"),
     }
+}
+
+/// The rest of a sweep resumed past a stop reports its progress over the whole band: a
+/// continuation over the last three quarters of an interval, handed on through
+/// `ProgressOverWhole` with offset 0.25, gives fractions from 0.25 to exactly 1, never
+/// decreasing (the furthest λ reached, through the S-curve's folds too), each equal to
+/// 0.25 + 0.75 × its own fraction.
+#[test]
+fn progress_over_the_whole_interval_goes_on_from_the_offset() {
+    let (mut own, mut whole) = (Vec::new(), Vec::new());
+    let mut record_whole = |_: &Point, fraction: f64| whole.push(fraction);
+    let mut both = |p: &Point, fraction: f64| {
+        own.push(fraction);
+        record_whole(p, 0.25 + 0.75 * fraction);
+    };
+    let branch = continue_branch(&mut SCurve, &[-2.0], -2.0, 2.0, &Options::default(), &mut both).unwrap();
+    assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+    let mut handed = Vec::new();
+    let mut record = |_: &Point, fraction: f64| handed.push(fraction);
+    let mut observer = ProgressOverWhole { inner: &mut record, offset: 0.25 };
+    continue_branch(&mut SCurve, &[-2.0], -2.0, 2.0, &Options::default(), &mut observer).unwrap();
+    assert_eq!(handed, whole, "the same branch, each fraction rescaled");
+    assert_eq!(handed.first().copied(), Some(0.25));
+    assert_eq!(handed.last().copied(), Some(1.0));
+    assert!(handed.windows(2).all(|w| w[0] <= w[1]), "{handed:?}");
+    assert!(own.iter().all(|f| (0.0..=1.0).contains(f)));
 }

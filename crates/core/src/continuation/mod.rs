@@ -487,6 +487,24 @@ impl<P: ?Sized, O: Observer + ?Sized> PointObserver<P> for O {
     }
 }
 
+/// Hands a continuation over the last part of an interval on to `inner` with its progress
+/// over the whole interval: the part starts at `offset` of the whole, so its fraction `f` is
+/// `offset + (1 − offset) f` of the whole (the rest of a sweep resumed past a stop, whose
+/// progress would otherwise start again from zero).
+pub struct ProgressOverWhole<'o, O: ?Sized> {
+    pub inner: &'o mut O,
+    pub offset: f64,
+}
+
+impl<P: ?Sized, O: PointObserver<P> + ?Sized> PointObserver<P> for ProgressOverWhole<'_, O> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, P>) {
+        let part = accepted.fraction_done;
+        accepted.fraction_done = (self.offset + (1.0 - self.offset) * part).clamp(0.0, 1.0);
+        self.inner.on_accepted(accepted);
+        accepted.fraction_done = part;
+    }
+}
+
 /// `∂R/∂x` (n × n) and `∂R/∂λ` at an accepted point ([`Accepted::jacobian`]).
 pub type JacobianAt<'a> = (MatRef<'a, f64>, &'a [f64]);
 

@@ -102,7 +102,9 @@ use super::element_aft::ElementAft;
 use super::fourier::{cos_index, sin_index, AftPlan};
 use super::receptance::{HarmonicReceptance, Receptance};
 use super::sweep::{from_level_ramp, off_resonance_of, resumed_past_stops, within, SweepError};
-use crate::continuation::{continue_branch, Branch, Options, PointObserver, Problem, ProblemError, Scales, Silent};
+use crate::continuation::{
+    continue_branch, Branch, Options, PointObserver, Problem, ProblemError, ProgressOverWhole, Scales, Silent,
+};
 use crate::elements::{Contact, ElementError};
 use crate::model::{LinearModel, ModelError, NonlinearModel};
 
@@ -690,6 +692,8 @@ pub fn sweep_frequency<O: ?Sized + for<'a> PointObserver<DlftFrequencySweep<'a>>
         },
         |dlft, guess, from| {
             let rest = within(options, band, from, omega_end);
+            let offset = 1.0 - (omega_end - from).abs() / band;
+            let observer = &mut ProgressOverWhole { inner: &mut *observer, offset };
             continue_branch(
                 &mut DlftFrequencySweep { dlft, level, unknowns_scale },
                 guess,

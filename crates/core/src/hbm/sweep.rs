@@ -7,7 +7,7 @@ use faer::MatMut;
 use super::condensed::{CondensedHbm, HbmError, Jacobians};
 use crate::continuation::{
     continue_branch, Branch, ContinuationError, FactoredJacobian, Options, PointObserver, Problem, ProblemError,
-    Resumption, Silent, TerminationReason,
+    ProgressOverWhole, Resumption, Silent, TerminationReason,
 };
 
 /// A sweep that could not start (a failure during the sweep is a termination reason of the
@@ -199,6 +199,8 @@ pub fn sweep_frequency<'m, O: ?Sized + for<'a> PointObserver<FrequencySweep<'a, 
         },
         |hbm, guess, from| {
             let rest = within(options, band, from, omega_end);
+            let offset = 1.0 - (omega_end - from).abs() / band;
+            let observer = &mut ProgressOverWhole { inner: &mut *observer, offset };
             continue_branch(&mut FrequencySweep { hbm, level }, guess, from, omega_end, &rest, observer)
         },
     ))
