@@ -102,7 +102,8 @@ fn a_sweep_solved_by_structure_follows_the_dense_sweep() {
 /// The factored reduced system (single precision, `StructuredJacobian::factor_reduced`) as the
 /// preconditioner: of the Jacobian that formed it, and of the next Jacobian on the same coupled
 /// directions. The iterations converge to 1e-12 in double precision whatever the preconditioner:
-/// the steps equal the dense LU's as the plain iterative solve's do (1e-8, above).
+/// the steps equal the dense LU's as the plain iterative solve's do (1e-8, above), and the
+/// earlier factor is kept (it converged, so no factor was formed afresh).
 #[test]
 fn a_factored_reduced_system_preconditions_this_and_the_next_jacobian() {
     let (model, force) = common::contact_patch(7);
@@ -129,7 +130,7 @@ fn a_factored_reduced_system_preconditions_this_and_the_next_jacobian() {
     assert!(coupled * 11 > 1200, "{coupled} directions couple harmonics: not iterative");
     assert!(jacobian.reduced_factor().is_none(), "nothing factored yet");
     jacobian.factor_reduced();
-    assert!(jacobian.reduced_factor().is_some());
+    let factor = jacobian.reduced_factor().expect("factored");
     let own = step_error(&mut hbm, &x);
     // The next iterate: 1 % further along the motion, the same directions slipping.
     let next: Vec<f64> = x.iter().map(|v| 1.01 * v).collect();
@@ -138,6 +139,10 @@ fn a_factored_reduced_system_preconditions_this_and_the_next_jacobian() {
     assert_eq!(jacobian.coupled_directions(), coupled);
     assert!(jacobian.reduced_factor().is_some(), "the earlier factor is handed on");
     let earlier = step_error(&mut hbm, &next);
+    // The earlier factor did precondition the solve (within its 12 iterations): a failure
+    // would have factored this Jacobian's own, handed on in its place.
+    let handed_on = hbm.structured_jacobian().unwrap().reduced_factor().unwrap();
+    assert!(std::sync::Arc::ptr_eq(&factor, &handed_on), "the earlier factor did not converge: refactored");
     println!("{coupled} directions: own factor {own:.1e}, earlier factor {earlier:.1e}");
     assert!(own < 1e-8 && earlier < 1e-8, "own factor {own:e}, earlier factor {earlier:e}");
 }
