@@ -148,3 +148,39 @@ fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds
         alone[2].solves
     );
 }
+
+#[test]
+fn a_spike_found_by_another_quantity_of_the_bracket_is_refined_for_this_one() {
+    // Two quantities of one bracket: the amplitude A, and B, a smooth hump near the bracket's
+    // start plus a spike at A's peak far narrower than the scan's lattice (a friction arc
+    // that one output's window misses and another's finds: Harmony's envelope contact and
+    // envelope top at 6000 N). Alone, B's search sees only the hump; after A's search, the
+    // points solved at A's peak show the spike, which B's search then refines.
+    let (m, wn, zeta, f) = (2.0, 2.0 * std::f64::consts::PI * 100.0, 0.02, 10.0);
+    let mut p = Oscillator { m, c: 2.0 * zeta * m * wn, k: m * wn * wn, k3: 0.0, f };
+    let guess = [f / (p.k - m * 0.25 * wn * wn), 0.0];
+    let branch = continue_branch(&mut p, &guess, 0.5 * wn, 1.5 * wn, &Options::default(), &mut Silent).unwrap();
+    let pts = &branch.points;
+    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    let bracket = [&pts[i - 1], &pts[i], &pts[i + 1]];
+    let w_peak = wn * (1.0 - 2.0 * zeta * zeta).sqrt();
+    let (w0, span) = (pts[i - 1].lambda, pts[i + 1].lambda - pts[i - 1].lambda);
+    // The spike: 1e-5 of the bracket wide, 500 times narrower than the lattice.
+    let width = 1e-5 * span;
+    let b = move |_: &mut Oscillator, _: &[f64], w: f64| {
+        let hump = 1.0 - ((w - (w0 + 0.05 * span)) / span).powi(2);
+        Ok(hump + 0.5 * (-((w - w_peak) / width).powi(2)).exp())
+    };
+    let alone = maximise_along(&mut p, bracket, 1e-9, b).unwrap();
+    assert!(alone.value < 1.01, "the scan alone found the spike: {}", alone.value);
+    let mut shared = Bracket::new(&mut p, bracket).unwrap();
+    let a = shared.maximise(&mut p, 1e-9, |_, x, _| Ok(amplitude(x))).unwrap();
+    assert!((a.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", a.lambda);
+    let found = shared.maximise(&mut p, 1e-9, b).unwrap();
+    // The spike's top: the hump there plus 0.5, where the hump's slope (2e-6 of the spike's
+    // curvature) moves it by ~1e-12 of the bracket: the value to 1e-9 (Brent's tolerance of
+    // 1e-9 on the chord, on a spike 1e-5 of it wide, gives (1e-4)² of its height).
+    let hump_at_peak = 1.0 - ((w_peak - (w0 + 0.05 * span)) / span).powi(2);
+    assert!((found.value - (hump_at_peak + 0.5)).abs() < 1e-9, "{} vs {}", found.value, hump_at_peak + 0.5);
+    assert!((found.lambda - w_peak).abs() < 1e-3 * width, "{} vs {w_peak}", found.lambda);
+}

@@ -333,6 +333,29 @@ impl Bracket {
                     value_at(self, problem, &mut values, s, refined)
                 })?;
             }
+            // The points solved for the bracket's other quantities (their scans and arcs) cost
+            // no solve here. One higher than all this quantity's own points (by more than a
+            // scan point's precision, ~1e-10 of the value) lies on an arc its window missed (a
+            // narrow spike: Harmony's envelope contact at 6000 N, 2e-5 above the arc its
+            // window found, beside the envelope top's); that arc is refined too.
+            let own = values.values().map(|v| v.0).fold(f64::NEG_INFINITY, f64::max);
+            let earlier: Vec<(f64, f64)> = self
+                .solved
+                .iter()
+                .filter(|(key, _)| !values.contains_key(key))
+                .filter_map(|(key, point)| Some((f64::from_bits(*key), point.as_ref()?.precision)))
+                .collect();
+            let mut higher = (f64::NAN, own + 1e-9 * own.abs());
+            for (s, precision) in earlier {
+                let value = value_at(self, problem, &mut values, s, precision)?;
+                if value > higher.1 {
+                    higher = (s, value);
+                }
+            }
+            if !higher.0.is_nan() {
+                let (a, b) = ((higher.0 - SCAN_SPACING).max(0.0), (higher.0 + SCAN_SPACING).min(1.0));
+                brent_maximum(a, b, higher, tolerance, |s| value_at(self, problem, &mut values, s, refined))?;
+            }
         }
         // The best point, converged to round-off (a scan's point is solved further if it is
         // the best, and may then be overtaken).
