@@ -75,7 +75,7 @@ fn the_peak_of_a_linear_oscillator_is_located_at_its_closed_form() {
     assert!((sampled.lambda - w_peak).abs() > 1e-5 * w_peak, "the default steps happen to hit the peak");
     assert!((found.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", found.lambda);
     assert!((found.value - a_peak).abs() < 1e-12 * a_peak, "{} vs {a_peak}", found.value);
-    // The middle point, the scan (16 lattice points or more) and Brent's steps.
+    // The middle point, the scan (16 lattice points or more) and the arc's steps.
     assert!(found.solves < 50, "{} solves", found.solves);
 }
 
@@ -125,8 +125,8 @@ fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds
         shared.maximise(&mut p, 1e-9, velocity).unwrap(),
         shared.maximise(&mut p, 1e-9, power).unwrap(),
     ];
-    // The same searches on the same points, solved to round-off from other guesses, so Brent's
-    // steps may differ by round-off: λ equal to the search's tolerance (1e-9 of the bracket's
+    // The same searches on the same points, solved to round-off from other guesses, so the
+    // arcs' steps may differ by round-off: λ equal to the search's tolerance (1e-9 of the bracket's
     // chord, itself ~10 % of λ: 1e-10, asserted 1e-9), the value to round-off (the peak is
     // flat: 1e-12 asserted).
     for (s, a) in found.iter().zip(&alone) {
@@ -136,7 +136,7 @@ fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds
     assert!((found[1].lambda - wn).abs() < 1e-9 * wn, "{} vs {wn}", found[1].lambda);
     assert!((found[0].lambda - found[1].lambda).abs() > 1e-4 * wn);
     // Each later search solved only the lattice points outside the earlier windows and its own
-    // Brent steps: the power's window is the amplitude's, so its search solved only Brent's
+    // arc steps: the power's window is the amplitude's, so its search solved only its arc's
     // steps (to 1e-9, at most ~20), against a scan besides alone (each side of the vertex down
     // the flank to two points DROP below the best: 5 points at least, 9 here).
     assert_eq!(found[0].solves, alone[0].solves);
@@ -178,7 +178,7 @@ fn a_spike_found_by_another_quantity_of_the_bracket_is_refined_for_this_one() {
     assert!((a.lambda - w_peak).abs() < 1e-9 * w_peak, "{} vs {w_peak}", a.lambda);
     let found = shared.maximise(&mut p, 1e-9, b).unwrap();
     // The spike's top: the hump there plus 0.5, where the hump's slope (2e-6 of the spike's
-    // curvature) moves it by ~1e-12 of the bracket: the value to 1e-9 (Brent's tolerance of
+    // curvature) moves it by ~1e-12 of the bracket: the value to 1e-9 (the search's tolerance of
     // 1e-9 on the chord, on a spike 1e-5 of it wide, gives (1e-4)² of its height).
     let hump_at_peak = 1.0 - ((w_peak - (w0 + 0.05 * span)) / span).powi(2);
     assert!((found.value - (hump_at_peak + 0.5)).abs() < 1e-9, "{} vs {}", found.value, hump_at_peak + 0.5);

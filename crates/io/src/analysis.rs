@@ -529,8 +529,9 @@ impl<'a, O: Observer + ?Sized> PointObserver<DlftFrequencySweep<'a>> for PointRe
 /// where the amplitude falls linearly away (by ~1e-3 of itself per unit of the chord on Table
 /// 6): 1e-5 there leaves ~1e-8 of the amplitude (measured on every shipped example against
 /// 1e-7: at most 3.2e-8 in amplitude and 1.4e-7 in frequency), far below the 1e-5 by which a
-/// friction peak's arcs differ, and saves ~10 golden-section steps per arc; a smooth top is
-/// found to far better (the amplitude is quadratic there).
+/// friction peak's arcs differ (the search steps onto a corner from the lines of its sides,
+/// then once either side of it); a smooth top is found to far better (the amplitude is
+/// quadratic there).
 const PEAK_TOLERANCE: f64 = 1e-5;
 
 /// Precision of a located bifurcation on the chord between its two points: the Floquet

@@ -12,8 +12,11 @@
 //! the corrector of Eq. 32 on the hyperplane orthogonal to the chord, so that a fold inside the
 //! bracket (a hardening peak) is parametrised as well as a plain peak. The quantity is scanned
 //! at a few values of `s` (a friction peak has several local maxima, see below), then maximised
-//! around the best by Brent's method (golden section with parabolic steps, Brent 1973, ch. 5). It is written here rather than taken from `argmin`,
-//! whose solver framework is far more than one bounded scalar search needs.
+//! around the best, on each arc near the top, by a search that follows the corners where a
+//! friction peak's arcs meet (the lines of their sides) and, on smooth tops, parabolas, with
+//! Brent's safeguards (Brent 1973, ch. 5). It is written here rather than taken from `argmin`,
+//! whose solver framework is far more than one bounded scalar search needs, and which has no
+//! search for corners.
 
 use std::collections::BTreeMap;
 
@@ -41,6 +44,12 @@ pub struct Extremum {
 
 /// 1 − 1/φ: the golden-section step.
 const GOLDEN: f64 = 0.381_966_011_250_105_1;
+/// Points solved at most to refine one arc.
+const MAX_ARC_STEPS: usize = 60;
+/// The best point of an arc and its two neighbours on one side are aligned, a side of a corner,
+/// where the slopes of their two segments differ by at most this fraction: a few per cent along
+/// a friction peak's side, ~100 % around a smooth top.
+const ALIGNED: f64 = 0.25;
 /// Newton iterations allowed for one point of the bracket.
 const MAX_ITERATIONS: usize = 30;
 /// Spacing of the scan on the bracket's chord (1 = the whole bracket, two continuation steps),
@@ -53,7 +62,7 @@ const MAX_ITERATIONS: usize = 30;
 const SCAN_SPACING: f64 = 0.02;
 const WINDOW: f64 = 0.15;
 /// Points solved within this distance start a new one (two lattice spacings and a half: the
-/// scan's neighbours, Brent's steps).
+/// scan's neighbours, the arcs' steps).
 const NEAR: f64 = 2.5 * SCAN_SPACING;
 /// A point is converged when its residual is at most this fraction of its unknowns' norm
 /// (`R = x − λ u_F + H G` is a difference of terms of the size of x: ~1000 ulps of them).
@@ -63,7 +72,7 @@ const ROUND_OFF: f64 = 1e-13;
 /// scanned point is below its arc's top by up to ~4e-5 (Table 6 at 100 N).
 const CANDIDATE: f64 = 2e-4;
 /// A point of the scan is accepted once Newton's next update would move it by at most this
-/// (scaled variables: of the bracket's x and λ spans), Brent's points once it would move them
+/// (scaled variables: of the bracket's x and λ spans), the arcs' points once it would move them
 /// by 1e-4 of the search's tolerance if that is less (the same at the tolerance of 1e-5 that
 /// peaks are located to). A value then errs by ~1e-10 of itself (measured against round-off on
 /// Table 6), far below the 1e-5 by which arcs differ and the ~1e-8 a corner's slope gives over
@@ -134,7 +143,7 @@ impl Bracket {
 
     /// The point at `s` (scaled) and its precision, solved once to `precision` (0: to
     /// round-off; see [`ChordPath::solve`]), further if asked for more later: from the line through the nearest points solved on either side, or
-    /// the two nearest on one side, if they are near (the scan's neighbours, Brent's steps: one
+    /// the two nearest on one side, if they are near (the scan's neighbours, the arcs' steps: one
     /// or two Newton iterations), else from the parabola through the three points. `None` if
     /// it cannot be solved there.
     fn point<P: Problem>(
@@ -250,7 +259,7 @@ impl Bracket {
         // in steps of one time sample as the phase turns through the resonance. Each arc has
         // its own local maximum, within ~1e-5 of the others near the top. The three sampled
         // points place the envelope's vertex (a parabola through them); a scan on a lattice
-        // finer than the arcs around it finds the arcs near the top, and Brent's method the
+        // finer than the arcs around it finds the arcs near the top, and `next_arc_point` the
         // maximum of each arc whose scanned best is near the best (the highest is kept).
         let fm = value_at(self, problem, &mut values, sm, SCAN_PRECISION)?;
         // Vertex of the parabola through (0, f0), (sm, fm), (1, f1).
@@ -325,13 +334,15 @@ impl Bracket {
                 })
                 .collect();
             candidates.sort_by(|&a, &b| samples[b].1.total_cmp(&samples[a].1));
-            // Brent's points to a precision far below its tolerance, so that its comparisons are
+            // The arcs' points to a precision far below the tolerance, so that their comparisons are
             // those of points converged to round-off.
             let refined = (1e-4 * tolerance).min(SCAN_PRECISION);
             for j in candidates {
-                brent_maximum(samples[j - 1].0, samples[j + 1].0, samples[j], tolerance, |s| {
-                    value_at(self, problem, &mut values, s, refined)
-                })?;
+                let (a, b) = (samples[j - 1].0, samples[j + 1].0);
+                for _ in 0..MAX_ARC_STEPS {
+                    let Some(s) = next_arc_point(&values, a, b, tolerance) else { break };
+                    value_at(self, problem, &mut values, s, refined)?;
+                }
             }
             // The points solved for the bracket's other quantities (their scans and arcs) cost
             // no solve here. One higher than all this quantity's own points (by more than a
@@ -353,8 +364,13 @@ impl Bracket {
                 }
             }
             if !higher.0.is_nan() {
-                let (a, b) = ((higher.0 - SCAN_SPACING).max(0.0), (higher.0 + SCAN_SPACING).min(1.0));
-                brent_maximum(a, b, higher, tolerance, |s| value_at(self, problem, &mut values, s, refined))?;
+                // Between its nearest points on either side (the other quantity's).
+                let a = values.range(..higher.0.to_bits()).next_back().map_or(0.0, |(k, _)| f64::from_bits(*k));
+                let b = values.range(higher.0.to_bits()..).nth(1).map_or(1.0, |(k, _)| f64::from_bits(*k));
+                for _ in 0..MAX_ARC_STEPS {
+                    let Some(s) = next_arc_point(&values, a, b, tolerance) else { break };
+                    value_at(self, problem, &mut values, s, refined)?;
+                }
             }
         }
         // The best point, converged to round-off (a scan's point is solved further if it is
@@ -598,74 +614,189 @@ impl ChordPath {
     }
 }
 
-/// Brent's method (golden section with parabolic steps) for a maximum of `f` on `[a, b]`, from
-/// an interior point `(x, f(x))` at least as high as the ends; to `tolerance` on the abscissa.
-/// Returns the best abscissa and value.
-fn brent_maximum(
-    mut a: f64,
-    mut b: f64,
-    (x0, f0): (f64, f64),
-    tolerance: f64,
-    mut f: impl FnMut(f64) -> Result<f64, ProblemError>,
-) -> Result<(f64, f64), ProblemError> {
-    // Minimise −f, as Brent writes it.
-    let (mut xs, mut w, mut v) = (x0, x0, x0);
-    let (mut fx, mut fw, mut fv) = (-f0, -f0, -f0);
-    let (mut d, mut e) = (0.0f64, 0.0f64);
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        let tol1 = tolerance;
-        let tol2 = 2.0 * tol1;
-        if (xs - m).abs() <= tol2 - 0.5 * (b - a) {
-            break;
-        }
-        let mut golden = true;
-        if e.abs() > tol1 {
-            let r = (xs - w) * (fx - fv);
-            let mut q = (xs - v) * (fx - fw);
-            let mut p = (xs - v) * q - (xs - w) * r;
-            q = 2.0 * (q - r);
-            if q > 0.0 {
-                p = -p;
-            } else {
-                q = -q;
-            }
-            let previous = e;
-            e = d;
-            if p.abs() < (0.5 * q * previous).abs() && p > q * (a - xs) && p < q * (b - xs) {
-                d = p / q;
-                let u = xs + d;
-                if u - a < tol2 || b - u < tol2 {
-                    d = tol1.copysign(m - xs);
-                }
-                golden = false;
-            }
-        }
-        if golden {
-            e = if xs >= m { a - xs } else { b - xs };
-            d = GOLDEN * e;
-        }
-        let u = if d.abs() >= tol1 { xs + d } else { xs + tol1.copysign(d) };
-        let fu = -f(u)?;
-        if fu <= fx {
-            if u >= xs {
-                a = xs;
-            } else {
-                b = xs;
-            }
-            (v, fv, w, fw, xs, fx) = (w, fw, xs, fx, u, fu);
+/// The next point to solve on the arc between `a` and `b` (scanned points of the bracket's
+/// chord, `s`) whose maximum is sought, given the quantity's values so far by `s`; `None` once
+/// the maximum is located: the points either side of the best are within twice the tolerance
+/// of each other (Brent's criterion), or one is as high as the best to round-off.
+///
+/// The top of a friction peak's arc is mostly a corner: the slip instants move by one time
+/// sample there, and the quantity rises and falls along two nearly straight sides (slopes of
+/// ~±2e-3 of the value per unit of the chord on Table 6, changing by a few per cent along a
+/// side). Where the best point and its two neighbours on one side are aligned, the next point
+/// is where that side's line meets the line through the next two points on the other side: on
+/// straight sides the corner itself, on curved ones a step or two from it; the steps then
+/// land on either side of the corner and close the bracket. Elsewhere (a smooth top, or a
+/// side that is not straight), the vertex of the parabola through the best point and its
+/// neighbours; a step is at least the tolerance, and a golden-section step of the larger side
+/// is taken where no model applies (Brent 1973, ch. 5, whose parabolas alone fit a corner
+/// badly: 11-15 points a corner at a tolerance of 1e-5, against 4-6 here). Written here: a
+/// bounded search over a cached, piecewise smooth function is what no optimisation crate
+/// offers.
+fn next_arc_point(values: &BTreeMap<u64, (f64, f64)>, a: f64, b: f64, tolerance: f64) -> Option<f64> {
+    // The points solved so far, in order of `s` (keys of positive `s` sort as `s`).
+    let points: Vec<(f64, f64)> =
+        values.iter().map(|(k, v)| (f64::from_bits(*k), v.0)).filter(|p| p.1.is_finite()).collect();
+    let inside = |p: &(f64, f64)| p.0 >= a && p.0 <= b;
+    let k = (0..points.len()).filter(|&i| inside(&points[i])).max_by(|&i, &j| points[i].1.total_cmp(&points[j].1))?;
+    // The best point at an end of the arc: the maximum is another arc's.
+    if k == 0 || k + 1 == points.len() || !inside(&points[k - 1]) || !inside(&points[k + 1]) {
+        return None;
+    }
+    let (lo, best, hi) = (points[k - 1], points[k], points[k + 1]);
+    // Located to the tolerance; or to round-off, a neighbour within twice the tolerance as
+    // high as the best (values that no longer tell the points apart).
+    let level = |p: (f64, f64)| p.1 >= best.1 - 4.0 * f64::EPSILON * best.1.abs();
+    if hi.0 - lo.0 <= 2.0 * tolerance
+        || (level(lo) && best.0 - lo.0 <= 2.0 * tolerance)
+        || (level(hi) && hi.0 - best.0 <= 2.0 * tolerance)
+    {
+        return None;
+    }
+    let slope = |p: (f64, f64), q: (f64, f64)| (q.1 - p.1) / (q.0 - p.0);
+    let aligned = |p, q, r| {
+        let (first, second) = (slope(p, q), slope(q, r));
+        (first - second).abs() <= ALIGNED * first.abs().max(second.abs())
+    };
+    // Where the rising line through p and q meets the falling line through r and t, if
+    // between `from` and `to` (or at the best point itself, to round-off), and the lines'
+    // value there.
+    let margin = 0.5 * tolerance;
+    let corner = |p, q: (f64, f64), r: (f64, f64), t, from: f64, to: f64| -> Option<(f64, f64)> {
+        let (rise, fall) = (slope(p, q), slope(r, t));
+        let s = (r.1 - q.1 + rise * q.0 - fall * r.0) / (rise - fall);
+        (rise > 0.0 && fall < 0.0 && s >= from - margin && s <= to + margin).then_some((s, q.1 + rise * (s - q.0)))
+    };
+    // Two points within 2.5 tolerances on one side of the best: the steps of one tolerance
+    // went on rising that way, so the lines met at the best point without a corner there (a
+    // side drawn across a hidden corner, on arcs narrower than the scan's spacing: Table 6's
+    // two-DOF variant at 3000 N). A golden-section step then explores the larger side.
+    let crowded = (k >= 2 && best.0 - points[k - 2].0 <= 2.5 * tolerance)
+        || (k + 2 < points.len() && points[k + 2].0 - best.0 <= 2.5 * tolerance);
+    let mut proposal = None;
+    if !crowded && k >= 2 && k + 2 < points.len() {
+        // The best point on the rising side, aligned with the two before it; or on the falling
+        // side, aligned with the two after it. The higher corner is taken.
+        let rising = aligned(points[k - 2], lo, best).then(|| corner(lo, best, hi, points[k + 2], best.0, hi.0));
+        let falling = aligned(best, hi, points[k + 2]).then(|| corner(points[k - 2], lo, best, hi, lo.0, best.0));
+        proposal =
+            [rising.flatten(), falling.flatten()].into_iter().flatten().max_by(|x, y| x.1.total_cmp(&y.1)).map(|c| c.0);
+    }
+    if proposal.is_none() && !crowded {
+        // The parabola through the three points, if concave: its vertex.
+        let (d_lo, d_hi) = (slope(lo, best), slope(best, hi));
+        let curvature = (d_hi - d_lo) / (hi.0 - lo.0);
+        let vertex = 0.5 * (lo.0 + best.0) - d_lo / (2.0 * curvature);
+        proposal = (curvature < 0.0 && vertex > lo.0 && vertex < hi.0).then_some(vertex);
+    }
+    // Within half the tolerance of a point solved (a step of exactly the tolerance is not).
+    let near = |s: f64| values.keys().any(|key| (f64::from_bits(*key) - s).abs() < 0.5 * tolerance);
+    if let Some(s) = proposal {
+        // A step of at least the tolerance: towards the proposal, else away from it once that
+        // side is closed to the tolerance.
+        let steps = if (s - best.0).abs() < tolerance {
+            let side = tolerance.copysign(s - best.0);
+            [best.0 + side, best.0 - side]
         } else {
-            if u < xs {
-                a = u;
-            } else {
-                b = u;
-            }
-            if fu <= fw || w == xs {
-                (v, fv, w, fw) = (w, fw, u, fu);
-            } else if fu <= fv || v == xs || v == w {
-                (v, fv) = (u, fu);
-            }
+            [s, s]
+        };
+        if let Some(s) = steps.into_iter().find(|s| !near(*s) && *s > lo.0 && *s < hi.0) {
+            return Some(s);
         }
     }
-    Ok((xs, -fx))
+    // Golden section of the larger side.
+    let s = if hi.0 - best.0 > best.0 - lo.0 {
+        best.0 + GOLDEN * (hi.0 - best.0)
+    } else {
+        best.0 - GOLDEN * (best.0 - lo.0)
+    };
+    (!near(s)).then_some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The arc search on `f` between `a` and `b` from the values at `initial` (a scan's points):
+    /// the best point, its value and the points solved.
+    fn search(f: impl Fn(f64) -> f64, [a, b]: [f64; 2], initial: &[f64], tolerance: f64) -> (f64, f64, usize) {
+        let mut values: BTreeMap<u64, (f64, f64)> = initial.iter().map(|&s| (s.to_bits(), (f(s), 0.0))).collect();
+        let mut steps = 0;
+        while let Some(s) = next_arc_point(&values, a, b, tolerance) {
+            assert!(s > a && s < b && steps < MAX_ARC_STEPS, "step {steps} at {s}");
+            values.insert(s.to_bits(), (f(s), 0.0));
+            steps += 1;
+        }
+        let (s, v) = values.iter().map(|(k, v)| (f64::from_bits(*k), v.0)).max_by(|x, y| x.1.total_cmp(&y.1)).unwrap();
+        (s, v, steps)
+    }
+
+    /// The scan's lattice around `centre`.
+    fn lattice(centre: f64) -> Vec<f64> {
+        (-3..=3).map(|k| centre + k as f64 * SCAN_SPACING).collect()
+    }
+
+    #[test]
+    fn a_corner_with_straight_sides_is_located_in_one_step_and_bracketed_in_two() {
+        // Sides of slopes +2e-3 and −1e-3 of the value per unit of s (Table 6 at 100 N), meeting
+        // at 0.5037, between two lattice points: the lines through two points per side meet
+        // there exactly (to round-off), so one step lands on it; two steps of one tolerance
+        // either side then close the bracket.
+        let corner = 0.5037;
+        let f = |s: f64| 1.0 + if s < corner { 2e-3 * (s - corner) } else { -1e-3 * (s - corner) };
+        let (s, v, steps) = search(f, [0.48, 0.52], &lattice(0.5), 1e-5);
+        assert!((s - corner).abs() < 1e-12, "{s}");
+        assert!((v - 1.0).abs() < 1e-15, "{v}");
+        assert_eq!(steps, 3);
+    }
+
+    #[test]
+    fn a_corner_between_curved_sides_is_located_in_a_few_steps() {
+        // Concave sides whose slopes change by 5 % over a lattice spacing (a friction peak's:
+        // a few per cent), meeting at 0.4963: located to the tolerance on s, where its value is
+        // within the slope times the tolerance. Brent's method needed 11-15 points for such
+        // corners at that tolerance (golden sections: the parabolas through a corner fit it
+        // badly).
+        let corner = 0.4963;
+        let f = |s: f64| {
+            let d = s - corner;
+            1.0 + if d < 0.0 { 2e-3 * d - 2.5e-3 * d * d } else { -1.5e-3 * d - 2.5e-3 * d * d }
+        };
+        let (s, v, steps) = search(f, [0.48, 0.52], &lattice(0.5), 1e-5);
+        assert!((s - corner).abs() <= 1e-5, "{s}");
+        assert!(1.0 - v <= 2e-3 * 1e-5, "{v}");
+        assert!(steps <= 5, "{steps} steps");
+    }
+
+    #[test]
+    fn a_smooth_top_is_located_to_the_tolerance() {
+        // A parabola: its vertex to the tolerance on s, as Brent's method locates it, in a
+        // few parabolic steps and the two steps of one tolerance either side that close the
+        // bracket.
+        let top = 0.50731;
+        let f = |s: f64| 1.0 - 3e-3 * (s - top) * (s - top);
+        for tolerance in [1e-5, 1e-9] {
+            let (s, _, steps) = search(f, [0.48, 0.52], &lattice(0.5), tolerance);
+            assert!((s - top).abs() <= tolerance, "{s} at tolerance {tolerance:e}");
+            assert!(steps <= 6, "{steps} steps at tolerance {tolerance:e}");
+        }
+    }
+
+    #[test]
+    fn the_search_stays_on_its_arc_of_a_chain_of_corners() {
+        // A friction peak's top: corners every 0.103 of the chord on a parabolic envelope
+        // (Table 6 at 100 N), the value falling by 2e-3 per unit of s after each corner and
+        // rising at 2e-3 to the next. The search between two lattice points around one
+        // corner finds that corner, not its neighbours'.
+        let corners: Vec<f64> = (0..10).map(|i| 0.0475 + 0.103 * i as f64).collect();
+        let envelope = |s: f64| 1.0 - 4e-4 * (s - 0.55) * (s - 0.55);
+        let f = |s: f64| {
+            let c = corners.iter().copied().min_by(|a, b| (a - s).abs().total_cmp(&(b - s).abs())).unwrap();
+            envelope(c) - 2e-3 * (s - c).abs()
+        };
+        let scan = lattice(0.56);
+        let (s, v, steps) = search(f, [scan[2], scan[4]], &scan, 1e-5);
+        assert!((s - corners[5]).abs() < 1e-9, "{s}");
+        assert!((v - envelope(corners[5])).abs() < 1e-14, "{v}");
+        assert!(steps <= 3, "{steps} steps");
+    }
 }
