@@ -799,4 +799,47 @@ mod tests {
         assert!((v - envelope(corners[5])).abs() < 1e-14, "{v}");
         assert!(steps <= 3, "{steps} steps");
     }
+
+    #[test]
+    fn random_chains_of_corners_wider_than_two_lattice_spacings_are_located_to_their_slope_times_the_tolerance() {
+        // 500 friction-like tops: corners every w ∈ [0.04, 0.12] of the chord on a parabolic
+        // envelope, sides rising at 5e-4..1e-2 of the value per unit of s towards each corner
+        // and falling at another such slope after it, each side curved by up to 3e-2 (random,
+        // a fixed xorshift sequence). The search starts from a scan's lattice (every 0.02 over
+        // ±0.24) on the arc of its best local maximum, as `maximise` does. On arcs at least two
+        // spacings wide the arc holds one corner: found to the tolerance, its value to the
+        // steepest slope times it (1e-2 × 1e-5 = 1e-7; 4.6e-8 measured at most), in 6.6 steps
+        // on average where Brent's method took 13.3 (measured on the same tops outside the
+        // code; the same misses as Brent on narrower arcs, where a lattice cannot tell arcs
+        // apart).
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut total_steps = 0;
+        for _ in 0..500 {
+            let (w, up, down) = (uniform(0.04, 0.12), uniform(5e-4, 1e-2), uniform(5e-4, 1e-2));
+            let (offset, curvature, centre) = (uniform(0.0, w), uniform(0.0, 3e-2), uniform(0.45, 0.55));
+            let f = |s: f64| {
+                let corner = offset + w * ((s - offset) / w).round();
+                let d = s - corner;
+                1.0 - 4e-4 * (corner - centre).powi(2) - if d < 0.0 { -up * d } else { down * d } - curvature * d * d
+            };
+            let scan: Vec<f64> = (-12..=12).map(|k| 0.5 + k as f64 * SCAN_SPACING).collect();
+            let j = (1..scan.len() - 1)
+                .filter(|&j| f(scan[j]) >= f(scan[j - 1]) && f(scan[j]) >= f(scan[j + 1]))
+                .max_by(|&a, &b| f(scan[a]).total_cmp(&f(scan[b])))
+                .unwrap();
+            let (a, b) = (scan[j - 1], scan[j + 1]);
+            let (_, v, steps) = search(f, [a, b], &scan, 1e-5);
+            let top = (0..=20000).map(|i| f(a + (b - a) * i as f64 / 20000.0)).fold(f64::NEG_INFINITY, f64::max);
+            // The dense grid's best is within 1e-2 × (b − a)/20000 = 2e-8 of the top.
+            assert!(top - v <= 1e-7, "{} below, w = {w}", top - v);
+            total_steps += steps;
+        }
+        assert!(total_steps <= 9 * 500, "{} steps on average", total_steps as f64 / 500.0);
+    }
 }
