@@ -4,8 +4,8 @@
 
 use faer::MatMut;
 use stickslip_core::continuation::{
-    continue_branch, singular_points, Accepted, Options, PointObserver, Predictor, Problem, ProblemError, Silent,
-    SingularKind, TerminationReason, TestFunctions,
+    continue_branch, singular_points, Accepted, FactoredJacobian, Options, PointObserver, Predictor, Problem,
+    ProblemError, Silent, SingularKind, TerminationReason, TestFunctions,
 };
 
 /// Keeps the test functions of every accepted point.
@@ -112,6 +112,73 @@ fn the_test_functions_equal_their_closed_forms_on_the_s_curve() {
         // point), det ∂R/∂x changes it at each fold.
         let signs: Vec<f64> = tests.0.iter().map(|t| t.as_ref().unwrap().bordered.sign).collect();
         assert!(signs.iter().all(|&s| s == signs[0]), "{predictor:?}");
+    }
+}
+
+/// The S-curve solved as a problem that factors its own Jacobian (by division): the
+/// continuation then has no determinant and no tangent at its points.
+struct FactoredSCurve {
+    derivative: f64,
+}
+
+impl Problem for FactoredSCurve {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), ProblemError> {
+        SCurve.evaluate(x, lambda, residual, jacobian)
+    }
+    fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
+        Some(self)
+    }
+}
+
+impl FactoredJacobian for FactoredSCurve {
+    fn evaluate_and_factor(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        residual: &mut [f64],
+        dr_dlambda: &mut [f64],
+    ) -> Result<bool, ProblemError> {
+        SCurve.evaluate(x, lambda, residual, None)?;
+        dr_dlambda[0] = -1.0;
+        self.derivative = 3.0 * x[0] * x[0] - 3.0;
+        Ok(self.derivative != 0.0)
+    }
+    fn solve(&mut self, rhs: &mut [f64]) -> bool {
+        rhs[0] /= self.derivative;
+        rhs[0].is_finite()
+    }
+}
+
+#[test]
+fn the_folds_of_a_problem_that_factors_its_own_jacobian_are_where_the_branch_turns_back() {
+    // No test functions at its points: the folds are the extrema of λ along the branch,
+    // located between the neighbours of the point where λ turns back.
+    let mut problem = FactoredSCurve { derivative: 1.0 };
+    let mut tests = Tests::default();
+    let branch = continue_branch(&mut problem, &[-2.0], -5.0, 5.0, &Options::default(), &mut tests).unwrap();
+    assert!(tests.0.iter().all(|t| t.is_none()));
+    let found = singular_points(&mut problem, &branch.points, &tests.0, 1e-10);
+    let kinds: Vec<_> = found.iter().map(|p| p.kind).collect();
+    assert_eq!(kinds, [SingularKind::Fold, SingularKind::Fold], "{found:?}");
+    for (p, (x, lambda)) in found.iter().zip([(-1.0, 2.0), (1.0, -2.0)]) {
+        assert!(p.located, "{p:?}");
+        let after = p.after_point;
+        let (a, b) = (branch.points[after].x[0], branch.points[after + 1].x[0]);
+        assert!((a - p.x[0]) * (b - p.x[0]) <= 0.0, "{p:?} not after point {after}: {a}, {b}");
+        // λ = ±(2 − 3 (x ± 1)² + ...): its extremum along the chord is located from values of
+        // λ, which fix x only to ~√(ε/3) ≈ 1e-8 of the fold in principle (parabolic steps do
+        // better: 8e-11 and 5e-10 measured), λ to round-off.
+        assert!((p.x[0] - x).abs() < 1e-8, "{p:?}");
+        assert!((p.lambda - lambda).abs() < 1e-14, "{p:?}");
     }
 }
 

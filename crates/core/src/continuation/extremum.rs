@@ -35,6 +35,8 @@ struct Solved {
 pub struct Extremum {
     pub x: Vec<f64>,
     pub lambda: f64,
+    /// Where on the chord between the bracket's ends (0 at the first, 1 at the last).
+    pub s: f64,
     /// The quantity there.
     pub value: f64,
     /// Points solved on the branch to locate it (not counting those shared with an earlier
@@ -118,12 +120,30 @@ pub struct Bracket {
 
 impl Bracket {
     pub fn new<P: Problem>(problem: &mut P, [before, middle, after]: [&Point; 3]) -> Result<Self, ProblemError> {
-        // Scaled variables z = [x/s_x, λ/s_λ]: the chord has comparable x and λ parts.
+        // Scaled variables z = [x/s_x, λ/s_λ], λ by its span: the chord has comparable x and
+        // λ parts.
+        let lambda_scale = (after.lambda - before.lambda).abs().max(1e-12 * middle.lambda.abs()).max(f64::MIN_POSITIVE);
+        Self::scaled(problem, [before, middle, after], lambda_scale)
+    }
+
+    /// The branch between three points around a fold, where λ turns back: λ scaled by its own
+    /// magnitude, so that the chord lies along x and its hyperplanes cross the fold
+    /// transversally (λ's span, as [`Self::new`] scales it, would make them hyperplanes of
+    /// nearly constant λ, which meet the branch twice near a fold or not at all).
+    pub fn across_fold<P: Problem>(problem: &mut P, points: [&Point; 3]) -> Result<Self, ProblemError> {
+        let lambda_scale = points.iter().map(|p| p.lambda.abs()).fold(f64::MIN_POSITIVE, f64::max);
+        Self::scaled(problem, points, lambda_scale)
+    }
+
+    fn scaled<P: Problem>(
+        problem: &mut P,
+        [before, middle, after]: [&Point; 3],
+        lambda_scale: f64,
+    ) -> Result<Self, ProblemError> {
         let x_scale = [before, middle, after]
             .iter()
             .map(|p| p.x.iter().map(|v| v * v).sum::<f64>().sqrt())
             .fold(f64::MIN_POSITIVE, f64::max);
-        let lambda_scale = (after.lambda - before.lambda).abs().max(1e-12 * middle.lambda.abs()).max(f64::MIN_POSITIVE);
         let scaled = |p: &Point| -> Vec<f64> {
             p.x.iter().map(|v| v / x_scale).chain(std::iter::once(p.lambda / lambda_scale)).collect()
         };
@@ -139,6 +159,11 @@ impl Bracket {
         // residual scale by default): as good as a scan's point, and its own value.
         let solved = BTreeMap::from([(sm.to_bits(), Some(Solved { z: zm.clone(), precision: SCAN_PRECISION }))]);
         Ok(Bracket { z0, zm, z1, sm, path, solved, solves: 0 })
+    }
+
+    /// `s` of the bracket's middle point on the chord between its ends.
+    pub fn middle(&self) -> f64 {
+        self.sm
     }
 
     /// The point at `s` (scaled) and its precision, solved once to `precision` (0: to
@@ -391,6 +416,7 @@ impl Bracket {
         Ok(Extremum {
             x: best_z[..n].iter().map(|v| v * x_scale).collect(),
             lambda: best_z[n] * lambda_scale,
+            s,
             value,
             solves: self.solves - solved_before,
         })
@@ -482,10 +508,10 @@ pub fn zero_along<P: Problem>(
         }
     }
     // The end nearer the zero (the values may have been halved: compare them afresh).
-    let (za, zb) = (a.1, b.1);
+    let ((sa, za), (sb, zb)) = (a, b);
     let (va, vb) = (value(problem, &za)?, value(problem, &zb)?);
-    let (z, value) = if va.abs() <= vb.abs() { (za, va) } else { (zb, vb) };
-    Ok(Extremum { x: z[..n].iter().map(|v| v * x_scale).collect(), lambda: z[n] * lambda_scale, value, solves })
+    let (s, z, value) = if va.abs() <= vb.abs() { (sa, za, va) } else { (sb, zb, vb) };
+    Ok(Extremum { x: z[..n].iter().map(|v| v * x_scale).collect(), lambda: z[n] * lambda_scale, s, value, solves })
 }
 
 /// Points of a branch between two of its points `z0` and `z1` (scaled, as the continuation's

@@ -45,7 +45,7 @@
 //! corner.
 
 use super::linear::Workspace;
-use super::{zero_along, Extremum, Point, Problem, ProblemError};
+use super::{zero_along, Bracket, Extremum, Point, Problem, ProblemError};
 
 /// A determinant as its sign (−1, 0 or +1) and the logarithm of its magnitude: the
 /// determinant of a few hundred pivots overflows, its logarithm does not.
@@ -184,7 +184,9 @@ pub struct SingularPoint {
 /// their test functions (`tests[i]` those of `points[i]`, as [`Accepted::test_functions`]
 /// gives them; `None` where there are none, which skips the two segments around), each located
 /// to `tolerance` on the chord between its two points. A fold: `τ_λ` changes sign (equivalently
-/// `det ∂R/∂x` does and `det B(τ)` does not); a branch point: `det B(τ)` changes sign.
+/// `det ∂R/∂x` does and `det B(τ)` does not); a branch point: `det B(τ)` changes sign. For a
+/// problem that factors its own Jacobian, which has no test functions, the folds alone, where
+/// λ turns back along the branch ([`turning_points`]).
 ///
 /// [`Accepted::test_functions`]: super::Accepted::test_functions
 pub fn singular_points<P: Problem>(
@@ -193,6 +195,9 @@ pub fn singular_points<P: Problem>(
     tests: &[Option<TestFunctions>],
     tolerance: f64,
 ) -> Vec<SingularPoint> {
+    if problem.factored().is_some() {
+        return turning_points(problem, points, tolerance);
+    }
     let mut found = Vec::new();
     for (i, pair) in points.windows(2).enumerate() {
         let (Some(Some(t0)), Some(Some(t1))) = (tests.get(i), tests.get(i + 1)) else { continue };
@@ -207,6 +212,43 @@ pub fn singular_points<P: Problem>(
                 Err(_) => SingularPoint { kind, x: p1.x.clone(), lambda: p1.lambda, after_point: i, located: false },
             });
         }
+    }
+    found
+}
+
+/// The folds of a branch of a problem that factors its own Jacobian ([`Problem::factored`]),
+/// whose points have no test functions (neither the determinant nor the tangent at a point is
+/// formed): where λ turns back, at a point where it is larger, or smaller, than at both its
+/// neighbours. Each is located as the extremum of λ between those neighbours
+/// ([`Bracket::across_fold`], [`Bracket::maximise`] of ±λ, to `tolerance` on their chord),
+/// which is where `det ∂R/∂x` vanishes and τ_λ changes sign. Branch points are not found.
+fn turning_points<P: Problem>(problem: &mut P, points: &[Point], tolerance: f64) -> Vec<SingularPoint> {
+    let mut found = Vec::new();
+    for i in 1..points.len().saturating_sub(1) {
+        let (before, here, after) = (points[i - 1].lambda, points[i].lambda, points[i + 1].lambda);
+        let sign = match (here > before && here > after, here < before && here < after) {
+            (true, _) => 1.0,
+            (_, true) => -1.0,
+            _ => continue,
+        };
+        let kind = SingularKind::Fold;
+        let located =
+            Bracket::across_fold(problem, [&points[i - 1], &points[i], &points[i + 1]]).and_then(|mut bracket| {
+                let extremum = bracket.maximise(problem, tolerance, |_, _, lambda| Ok(sign * lambda))?;
+                Ok((extremum, bracket.middle()))
+            });
+        found.push(match located {
+            Ok((e, middle)) => SingularPoint {
+                kind,
+                x: e.x,
+                lambda: e.lambda,
+                after_point: if e.s < middle { i - 1 } else { i },
+                located: true,
+            },
+            Err(_) => {
+                SingularPoint { kind, x: points[i].x.clone(), lambda: points[i].lambda, after_point: i, located: false }
+            }
+        });
     }
     found
 }
