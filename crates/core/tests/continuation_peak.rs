@@ -100,17 +100,29 @@ fn the_peak_of_a_hardening_duffing_oscillator_next_to_its_fold_is_located() {
     assert!((found.lambda - w_peak).abs() < 1e-6 * w_peak, "{} vs {w_peak}", found.lambda);
 }
 
+/// ω_n and ζ of [`resonance_at_default_steps`].
+const WN: f64 = 2.0 * std::f64::consts::PI * 100.0;
+const ZETA: f64 = 0.02;
+
+/// A linear oscillator (2 kg, 100 Hz, ζ = 2 %, 10 N) swept over 50-150 Hz at default steps:
+/// the problem, its points and the index of the largest sampled amplitude.
+fn resonance_at_default_steps() -> (Oscillator, Vec<Point>, usize) {
+    let (m, f) = (2.0, 10.0);
+    let mut p = Oscillator { m, c: 2.0 * ZETA * m * WN, k: m * WN * WN, k3: 0.0, f };
+    let guess = [f / (p.k - m * 0.25 * WN * WN), 0.0];
+    let branch = continue_branch(&mut p, &guess, 0.5 * WN, 1.5 * WN, &Options::default(), &mut Silent).unwrap();
+    let pts = branch.points;
+    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    (p, pts, i)
+}
+
 #[test]
 fn quantities_maximised_in_one_bracket_share_its_points_and_find_what_each_finds_alone() {
     // Two outputs of one resonance: the displacement amplitude A, and the velocity Ω A, which
     // peaks a little higher, at ω_n exactly against ω_n √(1 − 2ζ²); then the power A², which
     // peaks where A does.
-    let (m, wn, zeta, f) = (2.0, 2.0 * std::f64::consts::PI * 100.0, 0.02, 10.0);
-    let mut p = Oscillator { m, c: 2.0 * zeta * m * wn, k: m * wn * wn, k3: 0.0, f };
-    let guess = [f / (p.k - m * 0.25 * wn * wn), 0.0];
-    let branch = continue_branch(&mut p, &guess, 0.5 * wn, 1.5 * wn, &Options::default(), &mut Silent).unwrap();
-    let pts = &branch.points;
-    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    let (mut p, pts, i) = resonance_at_default_steps();
+    let wn = WN;
     let bracket = [&pts[i - 1], &pts[i], &pts[i + 1]];
     let velocity = |_: &mut Oscillator, x: &[f64], w: f64| Ok(w * amplitude(x));
     let power = |_: &mut Oscillator, x: &[f64], _: f64| Ok(amplitude(x).powi(2));
@@ -156,12 +168,8 @@ fn a_spike_found_by_another_quantity_of_the_bracket_is_refined_for_this_one() {
     // that one output's window misses and another's finds: Harmony's envelope contact and
     // envelope top at 6000 N). Alone, B's search sees only the hump; after A's search, the
     // points solved at A's peak show the spike, which B's search then refines.
-    let (m, wn, zeta, f) = (2.0, 2.0 * std::f64::consts::PI * 100.0, 0.02, 10.0);
-    let mut p = Oscillator { m, c: 2.0 * zeta * m * wn, k: m * wn * wn, k3: 0.0, f };
-    let guess = [f / (p.k - m * 0.25 * wn * wn), 0.0];
-    let branch = continue_branch(&mut p, &guess, 0.5 * wn, 1.5 * wn, &Options::default(), &mut Silent).unwrap();
-    let pts = &branch.points;
-    let i = (0..pts.len()).max_by(|&i, &j| amplitude(&pts[i].x).total_cmp(&amplitude(&pts[j].x))).unwrap();
+    let (mut p, pts, i) = resonance_at_default_steps();
+    let (wn, zeta) = (WN, ZETA);
     let bracket = [&pts[i - 1], &pts[i], &pts[i + 1]];
     let w_peak = wn * (1.0 - 2.0 * zeta * zeta).sqrt();
     let (w0, span) = (pts[i - 1].lambda, pts[i + 1].lambda - pts[i - 1].lambda);
