@@ -52,6 +52,9 @@ const MAX_ARC_STEPS: usize = 60;
 /// where the slopes of their two segments differ by at most this fraction: a few per cent along
 /// a friction peak's side, ~100 % around a smooth top.
 const ALIGNED: f64 = 0.25;
+/// A point solved for another quantity of the bracket shows an arc this quantity's search
+/// missed where it is higher than all this quantity's own points by more than this fraction.
+const MISSED_ARC: f64 = 1e-7;
 /// Newton iterations allowed for one point of the bracket.
 const MAX_ITERATIONS: usize = 30;
 /// Spacing of the scan on the bracket's chord (1 = the whole bracket, two continuation steps),
@@ -370,10 +373,12 @@ impl Bracket {
                 }
             }
             // The points solved for the bracket's other quantities (their scans and arcs) cost
-            // no solve here. One higher than all this quantity's own points (by more than a
-            // scan point's precision, ~1e-10 of the value) lies on an arc its window missed (a
-            // narrow spike: Harmony's envelope contact at 6000 N, 2e-5 above the arc its
-            // window found, beside the envelope top's); that arc is refined too.
+            // no solve here. One higher than all this quantity's own points by more than the
+            // precision a corner is located to (~2e-8 of the value: its slope times the
+            // tolerance) lies on an arc this quantity's window missed (a narrow spike: Harmony's
+            // envelope contact at 6000 N, 2e-5 above the arc its window found, beside the
+            // envelope top's); that arc is refined too. The others' points are left out of
+            // this quantity's values otherwise.
             let own = values.values().map(|v| v.0).fold(f64::NEG_INFINITY, f64::max);
             let earlier: Vec<(f64, f64)> = self
                 .solved
@@ -381,17 +386,25 @@ impl Bracket {
                 .filter(|(key, _)| !values.contains_key(key))
                 .filter_map(|(key, point)| Some((f64::from_bits(*key), point.as_ref()?.precision)))
                 .collect();
-            let mut higher = (f64::NAN, own + 1e-9 * own.abs());
-            for (s, precision) in earlier {
+            let mut higher = (f64::NAN, own + MISSED_ARC * own.abs());
+            for &(s, precision) in &earlier {
                 let value = value_at(self, problem, &mut values, s, precision)?;
                 if value > higher.1 {
                     higher = (s, value);
                 }
             }
-            if !higher.0.is_nan() {
-                // Between its nearest points on either side (the other quantity's).
+            // Between its nearest points on either side (the other quantity's).
+            let around = (!higher.0.is_nan()).then(|| {
                 let a = values.range(..higher.0.to_bits()).next_back().map_or(0.0, |(k, _)| f64::from_bits(*k));
                 let b = values.range(higher.0.to_bits()..).nth(1).map_or(1.0, |(k, _)| f64::from_bits(*k));
+                (a, b)
+            });
+            for (s, _) in earlier {
+                if around.is_none_or(|(a, b)| s < a || s > b) {
+                    values.remove(&s.to_bits());
+                }
+            }
+            if let Some((a, b)) = around {
                 for _ in 0..MAX_ARC_STEPS {
                     let Some(s) = next_arc_point(&values, a, b, tolerance) else { break };
                     value_at(self, problem, &mut values, s, refined)?;
