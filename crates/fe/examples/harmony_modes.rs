@@ -4,10 +4,10 @@
 //! `cargo run --release -p stickslip-fe --example harmony_modes -- [REFINEMENT] [KEY=VALUE ...]`
 //!
 //! KEY=VALUE overrides a dimension of the design (m): `diaphragm_thickness`, `blade_thickness`,
-//! `shaker_zone_radius`, `hub_outer_radius`, `screw_radius_1`, `screw_radius_2`, and the optional
-//! geometry of the body substructure study (docs/harmony.md): `body_flange_radius`,
-//! `top_disk_thickness`, `rim_width`, `top_disk_inner_radius`, `top_disk_inner_thickness`,
-//! `blade_height`.
+//! `blade_length`, `shaker_zone_radius`, `hub_outer_radius`, `screw_radius_1`, `screw_radius_2`,
+//! and the geometry of the body and blades (docs/harmony.md): `blade_rise`,
+//! `body_flange_radius`, `top_disk_thickness`, `rim_width`, `top_disk_inner_radius`,
+//! `top_disk_inner_thickness`, `blade_height`.
 
 use std::time::Instant;
 
@@ -46,6 +46,8 @@ fn set(design: &mut Design, key: &str, v: f64) {
             design.variant.top_disk_inner = Some((design.variant.top_disk_inner.map_or(0.0, |i| i.0), v));
         }
         "blade_height" => design.variant.blade_height = Some(v),
+        "blade_rise" => design.variant.blade_rise = v,
+        "blade_length" => design.blade_length = v,
         other => panic!("unknown key {other}"),
     }
 }

@@ -4,26 +4,29 @@
 //!
 //! The paper gives the parts' materials, envelope dimensions and measured masses (Table 1), the
 //! modelling of the joints (Section 3.1) and the frequencies of the updated model (Tables 4-5),
-//! not the drawings. This geometry is therefore Harmony-like: bodies of revolution and flat
-//! blades whose free dimensions are set so that (i) each part has its measured mass and (ii) the
-//! assembly's first two axial modes and its all-slipping resonance are the paper's. Which
-//! dimension plays which role:
-//! - the body is a hub tube standing on a thin annular diaphragm clamped in the envelope's bottom
-//!   ring, with a top disk carrying the blades; the diaphragm thickness sets the body's axial
-//!   mode with the blades slipping (paper: ~190 Hz);
-//! - the blades are cantilevers from the top disk's rim to the envelope's inner wall, where the
-//!   contact holds their tip: their thickness (width from the blade mass) sets the stiffening when
-//!   stuck (paper: 237.6 Hz);
-//! - the shaker's coupling to the base plate (radius of the coupled zone, 40 mm) sets the
+//! not the drawings. This geometry is therefore Harmony-like: bodies of revolution and Table 1's
+//! blades (65 × 118 mm plates, 1.82 mm thick from their mass) whose free dimensions are set so
+//! that (i) each part has its measured mass and (ii) the assembly's first two axial modes, its
+//! all-slipping resonance and the substructures' modes are the paper's. Which dimension plays
+//! which role:
+//! - the body is a hub tube standing on a thin annular diaphragm, the body's flange inside
+//!   `body_flange_radius` and the envelope's web outside, with a 12 mm top disk carrying the
+//!   blades; the diaphragm thickness sets the body's axial mode with the blades slipping (paper:
+//!   ~190 Hz), the flange radius the body substructure's synchronous mode, clamped on that
+//!   circle (Table 4: 210.8 Hz);
+//! - each blade is screwed flat on the top disk and bent up at the outer edge of its outer screw
+//!   zone, rising `blade_rise` to its tip against the envelope's inner wall (the paper's blades
+//!   are "compressed" against it, Section 2.1). The screws' radii set the free length, hence the
+//!   blades' bending modes in the body substructure (Table 4: four at 254-260 Hz); the rise sets
+//!   the stiffening when stuck (paper: 237.6 Hz): held by the contact, an inclined blade resists
+//!   the body's axial motion by its membrane stiffness, slipping it follows as a rigid piece;
+//! - the shaker's coupling to the base plate (radius of the coupled zone, 37 mm) sets the
 //!   envelope substructure's first vertical mode on the shaker, the base plate and envelope
 //!   bouncing on the base plate's bending (Table 4: 880.4 Hz, test 889 Hz); in the assembly that
-//!   mode (~895 Hz) and the body's second axial mode (~854 Hz) are the pair near the paper's
-//!   second axial mode (878.4 Hz).
+//!   mode is the second axial mode (Table 5: 878.4 Hz).
 //!
-//! The body substructure of Table 4 (synchronous axial mode 210.8 Hz, four asynchronous blade
-//! modes at 254-260 Hz) is not met by this design; the optional geometry of [`BodyVariant`]
-//! (a split flange, a thin, stepped or rimmed top disk, blades on edge) builds the variants that
-//! docs/harmony.md measures to show why.
+//! [`BodyVariant`] also builds the variants docs/harmony.md measured on the way (blades on edge,
+//! a thin, stepped or rimmed top disk, flat blades).
 //!
 //! Modelling as Section 3.1: reference nodes rigidly drive the screw zones (radius 10 mm) on
 //! each blade and on the body, the blade tip face ("Top_Blade") and the envelope's contact zone
@@ -164,15 +167,16 @@ pub struct Design {
     pub envelope_ring_height: f64,
     /// Inner radius of the bottom ring (= outer radius of the diaphragm).
     pub envelope_ring_inner_radius: f64,
-    /// Central body height (Table 1: 300 mm), mass (11.92 kg); the top disk thickness follows.
+    /// Central body height (Table 1: 300 mm), mass (11.92 kg); the top disk thickness or the
+    /// hub's inner radius follows.
     pub body_height: f64,
     pub body_mass: f64,
     pub body_top_radius: f64,
     pub hub_outer_radius: f64,
     pub hub_inner_radius: f64,
     pub diaphragm_thickness: f64,
-    /// Optional body geometry (the variants docs/harmony.md measures for Table 4); the default
-    /// is the design's. Boxed: a study keeps a `Design` by value.
+    /// Geometry of the body and blades beyond Table 1 (flange, top disk, the blades' rise).
+    /// Boxed: a study keeps a `Design` by value.
     pub variant: Box<BodyVariant>,
     /// Blade length (Table 1: 118 mm), mass (0.1086 kg), thickness; the width follows.
     pub blade_length: f64,
@@ -216,12 +220,12 @@ impl Default for Design {
             body_top_radius: 0.156,
             hub_outer_radius: 0.060,
             hub_inner_radius: 0.054,
-            diaphragm_thickness: 0.00431,
+            diaphragm_thickness: 0.00448,
             variant: Box::default(),
             blade_length: 0.118,
             blade_mass: 0.1086,
-            blade_thickness: 0.0088,
-            screw_radii: [0.105, 0.135],
+            blade_thickness: 0.00182,
+            screw_radii: [0.093, 0.115],
             screw_zone_radius: 0.010,
             contact_zone_half_height: 0.010,
             connector_stiffness: 1e10,
@@ -229,7 +233,7 @@ impl Default for Design {
             tip_contact: TipContact::Connector,
             shaker_mass: 10.0,
             shaker_spring: 22800.0,
-            shaker_zone_radius: 0.040,
+            shaker_zone_radius: 0.037,
             steel_304l: Material { young: 193e9, poisson: 0.29, density: 7900.0 },
             aluminium_2017a: Material { young: 72.5e9, poisson: 0.33, density: 2790.0 },
             blade_steel: Material { young: 196e9, poisson: 0.272, density: 7780.0 },
@@ -237,7 +241,8 @@ impl Default for Design {
     }
 }
 
-/// Optional geometry of the body and blades, for the study of the body substructure (Table 4).
+/// Geometry of the body and blades beyond Table 1, set by the calibration of the body
+/// substructure (Table 4); its default is the calibrated design's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BodyVariant {
     /// Outer radius of the body's flange: the diaphragm from the hub to this radius is the body's,
@@ -256,16 +261,23 @@ pub struct BodyVariant {
     /// Blades standing on edge: a plate `blade_height` high (vertical), its thickness
     /// (tangential) from the mass; `blade_thickness` is then not used. `None`: flat blades.
     pub blade_height: Option<f64>,
+    /// Blades bent up at the outer edge of their outer screw zone, rising by this much (m) to
+    /// their tip: leaf springs pressed against the wall (the paper's blades "are compressed",
+    /// Section 2.1). Stuck, an inclined blade holds the body top by its membrane stiffness
+    /// (E A / L sin² of the angle); slipping, it follows the body as a rigid piece; its
+    /// bending modes are those of the flat cantilever. 0: flat blades.
+    pub blade_rise: f64,
 }
 
 impl Default for BodyVariant {
     fn default() -> Self {
         BodyVariant {
-            body_flange_radius: None,
-            top_disk_thickness: None,
-            rim_width: 0.02,
+            body_flange_radius: Some(0.1378),
+            top_disk_thickness: Some(0.012),
+            rim_width: 0.0,
             top_disk_inner: None,
             blade_height: None,
+            blade_rise: 0.0145,
         }
     }
 }
@@ -452,7 +464,12 @@ impl Design {
                 self.body_mass
             )));
         }
-        let blade_width = self.blade_mass / (self.blade_steel.density * self.blade_length * self.blade_vertical());
+        let rise = self.variant.blade_rise;
+        if !(rise >= 0.0 && rise.is_finite()) || (rise > 0.0 && self.variant.blade_height.is_some()) {
+            return Err(self.fail(format!("blade_rise must be >= 0 m, and 0 for blades on edge, got {rise}")));
+        }
+        let blade_width = self.blade_mass
+            / (self.blade_steel.density * self.blade_developed_length(envelope_inner_radius) * self.blade_vertical());
         // The blade runs from the envelope wall inwards, over the top disk, where it is screwed.
         let blade_root = envelope_inner_radius - self.blade_length;
         let free_span = envelope_inner_radius - self.body_top_radius;
@@ -470,10 +487,16 @@ impl Design {
                 )));
             }
         }
+        if (self.screw_radii[1] - self.screw_radii[0]).abs() <= 2.0 * self.screw_zone_radius {
+            return Err(self.fail(format!(
+                "screw_radii = {:?} m: the two screw zones (radius {} m) overlap",
+                self.screw_radii, self.screw_zone_radius
+            )));
+        }
         if blade_width >= 2.0 * self.body_top_radius * (PI / 4.0).sin() {
             return Err(self.fail(format!("blades {blade_width:.4} m wide overlap on the top disk")));
         }
-        if self.blade_vertical() + self.body_height + self.envelope_ring_height - self.diaphragm_thickness
+        if rise + self.blade_vertical() + self.body_height + self.envelope_ring_height - self.diaphragm_thickness
             >= self.envelope_height
         {
             return Err(self.fail("the blades stand above the envelope's top".into()));
@@ -514,7 +537,7 @@ impl Design {
             diaphragm_bottom,
             disk_bottom,
             disk_top,
-            disk_top + self.blade_vertical(),
+            disk_top + self.variant.blade_rise + self.blade_vertical(),
             base_top + self.envelope_height,
         ]
     }
@@ -531,8 +554,25 @@ impl Design {
         let nodes_per_cell = if self.kind == SolidKind::Hex8 { 1.0 } else { 4.0 };
         // The revolved solid fills about half of its (r, z) bounding box. In f64, saturating
         // on conversion: a tiny element size from a damaged study file overflowed usize here.
-        let blade_cells: f64 = self.blade_cells().iter().map(|&c| c as f64).product();
+        let blade_cells: f64 = self.blade_cells(&d).iter().map(|&c| c as f64).product();
         Ok((3.0 * nodes_per_cell * 0.5 * radial * axial * sectors + 4.0 * 3.0 * blade_cells * 4.0) as usize)
+    }
+
+    /// Where a blade with a rise is bent up (m from the axis): the outer edge of its outer
+    /// screw zone.
+    fn blade_bend(&self) -> f64 {
+        self.screw_radii[0].max(self.screw_radii[1]) + self.screw_zone_radius
+    }
+
+    /// Length of a blade along its plate: its radial length, or with a rise, the flat part and
+    /// the inclined one.
+    fn blade_developed_length(&self, envelope_inner_radius: f64) -> f64 {
+        let rise = self.variant.blade_rise;
+        if rise == 0.0 {
+            return self.blade_length;
+        }
+        let inclined = envelope_inner_radius - self.blade_bend();
+        self.blade_length - inclined + inclined.hypot(rise)
     }
 
     /// Vertical size of a blade: its thickness if flat, its height if standing on edge.
@@ -562,7 +602,7 @@ impl Design {
         }
         let half = self.tip_half_angle(d);
         let step = FRAC_PI_2 / quarter as f64;
-        let across = self.blade_cells()[1];
+        let across = self.blade_cells(d)[1];
         let mut stations = vec![-FRAC_PI_4, FRAC_PI_4];
         stations.extend((1..quarter).map(|j| -FRAC_PI_4 + j as f64 * step).filter(|t| t.abs() >= half + 0.5 * step));
         stations.extend((0..=across).map(|k| half * (2.0 * k as f64 / across as f64 - 1.0)));
@@ -575,35 +615,52 @@ impl Design {
         (0.5 * d.blade_width / d.envelope_inner_radius).asin()
     }
 
-    fn blade_cells(&self) -> [usize; 3] {
+    fn blade_cells(&self, d: &Dimensions) -> [usize; 3] {
         let along = ((self.blade_length / (0.5 * self.element_size)).ceil() as usize).max(8);
         if let Some(h) = self.variant.blade_height {
             // On edge: one quadratic element through the thin plate, the height cut as the length.
             return [along, 1, ((h / (0.5 * self.element_size)).ceil() as usize).max(2)];
         }
-        let across = ((0.03 / self.element_size).ceil() as usize).max(2);
+        // Across: at least 3 cm per cell, and two per element size on a wide blade (a screw
+        // zone then has nodes around its centre, not only along the blade's middle line).
+        let across = ((0.03 / self.element_size).ceil() as usize)
+            .max(2)
+            .max((d.blade_width / (0.5 * self.element_size)).ceil() as usize);
         [along, across, 1 + (self.element_size < 0.01) as usize]
     }
 
-    /// A blade of [`TipContact::Patch`] along the unit vector `[c, s]`: the placed box of the
+    /// A blade of [`TipContact::Patch`] along the unit vector `[c, s]`: the placed boxes of the
     /// connector model, but cut across at equal angles seen from the axis and ending on the
     /// wall's circle, so that each tip node lies on the wall at one of the angles that
     /// [`Design::quarter_angles`] gives the wall. The tip's edges stay at ±width/2; its corners
     /// move in by at most width²/(8 R), 0.12 mm for the default design, about 0.07 % of the
-    /// blade's volume.
-    fn blade_on_wall(&self, d: &Dimensions, [c, s]: [f64; 2], disk_top: f64) -> Block {
+    /// blade's volume. With a rise, a flat block to the bend and an inclined one from it.
+    fn blade_on_wall(&self, d: &Dimensions, [c, s]: [f64; 2], disk_top: f64) -> Vec<Block> {
         let (radius, half, vertical) = (d.envelope_inner_radius, self.tip_half_angle(d), self.blade_vertical());
-        let root = radius - self.blade_length;
-        Block {
-            cells: self.blade_cells(),
-            map: Box::new(move |[u, v, w]| {
-                let angle = half * (2.0 * v - 1.0);
-                let along = root + u * (radius * angle.cos() - root);
-                let across = radius * angle.sin();
-                [along * c - across * s, along * s + across * c, disk_top + w * vertical]
-            }),
-            elset: "BLADES".into(),
-        }
+        let (root, rise) = (radius - self.blade_length, self.variant.blade_rise);
+        let [along_cells, across, through] = self.blade_cells(d);
+        let cells = |l: f64| ((l / (0.5 * self.element_size)).ceil() as usize).max(4);
+        // (start radius, end radius or the wall's (None), rise over the block, cells along)
+        let segments = if rise > 0.0 {
+            let bend = self.blade_bend();
+            vec![(root, Some(bend), 0.0, cells(bend - root)), (bend, None, rise, cells((radius - bend).hypot(rise)))]
+        } else {
+            vec![(root, None, 0.0, along_cells)]
+        };
+        segments
+            .into_iter()
+            .map(|(start, end, up, n)| Block {
+                cells: [n, across, through],
+                map: Box::new(move |[u, v, w]| {
+                    let angle = half * (2.0 * v - 1.0);
+                    let end = end.unwrap_or(radius * angle.cos());
+                    let along = start + u * (end - start);
+                    let across = radius * angle.sin();
+                    [along * c - across * s, along * s + across * c, disk_top + u * up + w * vertical]
+                }),
+                elset: "BLADES".into(),
+            })
+            .collect()
     }
 
     /// For each blade of [`TipContact::Patch`], its tip nodes paired with the revolved part's
@@ -670,19 +727,21 @@ impl Design {
                 "ENVELOPE",
             ));
             // The wall, cut at the blades' heights so that the contact zones have nodes there.
-            let zc = 0.5 * (disk_top + blade_top);
+            let tip_bottom = blade_top - self.blade_vertical();
+            let zc = 0.5 * (tip_bottom + blade_top);
             let mut cuts = vec![
                 ring_top,
                 zc - self.contact_zone_half_height,
                 disk_top,
+                tip_bottom,
                 blade_top,
                 zc + self.contact_zone_half_height,
                 envelope_top,
             ];
             if patch {
                 // The tip's vertical subdivisions, so that the wall's nodes meet the tip's.
-                let cells = self.blade_cells()[2];
-                cuts.extend((1..cells).map(|k| disk_top + k as f64 / cells as f64 * self.blade_vertical()));
+                let cells = self.blade_cells(&d)[2];
+                cuts.extend((1..cells).map(|k| tip_bottom + k as f64 / cells as f64 * self.blade_vertical()));
             }
             cuts.sort_by(f64::total_cmp);
             for w in cuts.windows(2) {
@@ -749,10 +808,25 @@ impl Design {
                     [0.0, 0.0, self.blade_vertical()],
                 ];
                 let mut part = Part::new(&format!("BLADE_{}", i + 1), self.kind, tol)?;
+                let rise = self.variant.blade_rise;
                 if patch {
-                    part.add_block(&self.blade_on_wall(&d, [c, s], disk_top))?;
+                    for block in self.blade_on_wall(&d, [c, s], disk_top) {
+                        part.add_block(&block)?;
+                    }
+                } else if rise > 0.0 {
+                    // Flat over the screws, then inclined up to the wall: two boxes sharing
+                    // the vertical face at the bend.
+                    let flat = self.blade_bend() - root;
+                    let inclined = d.envelope_inner_radius - self.blade_bend();
+                    let cells = |l: f64| ((l / (0.5 * self.element_size)).ceil() as usize).max(4);
+                    let [_, across, through] = self.blade_cells(&d);
+                    let flat_edges = [[flat * c, flat * s, 0.0], edges[1], edges[2]];
+                    part.add_block(&placed_box(origin, flat_edges, [cells(flat), across, through], "BLADES"))?;
+                    let bend = [origin[0] + flat * c, origin[1] + flat * s, disk_top];
+                    let up = [[inclined * c, inclined * s, rise], edges[1], edges[2]];
+                    part.add_block(&placed_box(bend, up, [cells(inclined.hypot(rise)), across, through], "BLADES"))?;
                 } else {
-                    part.add_block(&placed_box(origin, edges, self.blade_cells(), "BLADES"))?;
+                    part.add_block(&placed_box(origin, edges, self.blade_cells(&d), "BLADES"))?;
                 }
                 blades.push(part);
             }
@@ -796,7 +870,7 @@ impl Design {
         // Conforming tips: each tip node's partner on the wall (part node indices), and the
         // nodes named Top_Blade and Contact_Zone, at the centre of the tip face.
         let faces = if patch && with_envelope {
-            self.tip_faces(&blades, &revolved, &d, 0.5 * (disk_top + blade_top), tol)?
+            self.tip_faces(&blades, &revolved, &d, blade_top - 0.5 * self.blade_vertical(), tol)?
         } else {
             Vec::new()
         };
@@ -842,18 +916,28 @@ impl Design {
             point_id += 1;
         };
 
-        // Zones: face nodes of a part within `radius` of a point, grown until three are not
-        // collinear (a coarse mesh may have fewer nodes within the paper's 10 mm).
+        // Zones: face nodes of a part within `radius` of a point, and if these are collinear
+        // (a coarse mesh may have only a line of nodes within the paper's 10 mm), the nearest
+        // node off their line: growing by the nearest nodes overall would reach along the
+        // line into a neighbouring screw's zone.
         let zone = |nodes: &[usize], mesh: &Mesh, centre: [f64; 3], radius: f64| -> Vec<usize> {
             let dist = |n: usize| (0..3).map(|i| (mesh.nodes[n].xyz[i] - centre[i]).powi(2)).sum::<f64>().sqrt();
             let mut sorted: Vec<usize> = nodes.to_vec();
             sorted.sort_by(|&a, &b| dist(a).total_cmp(&dist(b)));
-            let mut take = sorted.iter().take_while(|&&n| dist(n) <= radius).count().max(3);
-            while take < sorted.len() && collinear(mesh, &sorted[..take]) {
-                take += 1;
+            let take =
+                sorted.iter().take_while(|&&n| dist(n) <= radius).count().clamp(2.min(sorted.len()), sorted.len());
+            let mut zone = sorted[..take].to_vec();
+            if collinear(mesh, &zone) {
+                if let Some(&off) = sorted[take..].iter().find(|&&n| {
+                    zone.push(n);
+                    let off = !collinear(mesh, &zone);
+                    zone.pop();
+                    off
+                }) {
+                    zone.push(off);
+                }
             }
-            sorted.truncate(take);
-            sorted
+            zone
         };
 
         if with_body {
@@ -908,7 +992,7 @@ impl Design {
                     .iter()
                     .map(|&n| idx[n])
                     .collect();
-                let zc = 0.5 * (disk_top + blade_top);
+                let zc = blade_top - 0.5 * self.blade_vertical();
                 let tip_point = [d.envelope_inner_radius * c, d.envelope_inner_radius * s, zc];
                 let t = add_ref(&mut mesh, top_blade(i + 1), tip_point, &format!("TOP_BLADE_{}", i + 1))?;
                 mesh.couplings.push(RigidCoupling {

@@ -10,38 +10,46 @@ use stickslip_fe::mesh::structured::GenerateError;
 use stickslip_fe::patch::pair_sets;
 
 /// Frequencies (Hz) of the axial modes among the lowest `count`: those where the top of the
-/// central body (accelerometer 101) moves vertically more than a tenth of the most it does.
+/// central body (accelerometer 101) or the centre of the base plate (102) moves vertically more
+/// than a tenth of the most it does.
 fn axial_modes(design: &Design, count: usize) -> (Vec<f64>, f64) {
     let mesh = design.build(Configuration::Assembly).expect("a buildable design");
     let fe = FeModel::assemble(mesh).expect("assembly");
     let (k, m) = (to_sparse(&fe.model.stiffness), to_sparse(&fe.model.mass));
     let (k, m) = (k.into_owned(), m.into_owned());
     let sol = solve(&k, &m, &EigenOptions { count, ..Default::default() }).expect("modes");
-    let top = fe.dof(harmony::accelerometer(0), 3).expect("body top DOF");
-    let amp: Vec<f64> = (0..count).map(|j| sol.modes.shapes[(top, j)].abs()).collect();
-    let largest = amp.iter().copied().fold(0.0, f64::max);
     let f = sol.modes.frequencies_hz();
-    // The first mode is the whole structure on the shaker's soft spring (~2.7 Hz).
-    let axial = (1..count).filter(|&j| amp[j] > 0.1 * largest).map(|j| f[j]).collect();
+    let mut axial = Vec::new();
+    for probe in [0, 1] {
+        let dof = fe.dof(harmony::accelerometer(probe), 3).expect("sensor DOF");
+        let amp: Vec<f64> = (0..count).map(|j| sol.modes.shapes[(dof, j)].abs()).collect();
+        // The first mode is the whole structure on the shaker's soft spring (~2.7 Hz).
+        let largest = amp.iter().skip(1).copied().fold(0.0, f64::max);
+        axial.extend((1..count).filter(|&j| amp[j] > 0.1 * largest).map(|j| f[j]));
+    }
+    axial.sort_by(f64::total_cmp);
+    axial.dedup();
     (axial, fe.solid_mass)
 }
 
 #[test]
 fn coarse_assembly_has_the_paper_axial_modes_and_masses() {
     let design = Design::refined(0.5);
-    let (stuck, mass) = axial_modes(&design, 16);
+    let (stuck, mass) = axial_modes(&design, 24);
+    println!("stuck axial modes {stuck:.1?} Hz");
     // Table 1: 9.47 + 44.88 + 11.92 + 4 x 0.1086 kg; the parts' dimensions are set from these
     // masses on the exact geometry, the mesh differs by the arcs' quadratic interpolation.
     let table1 = 9.47 + 44.88 + 11.92 + 4.0 * 0.1086;
     assert!((mass - table1).abs() < 5e-3 * table1, "solid mass {mass} kg vs Table 1 {table1} kg");
     // Table 5: 237.6 Hz and 878.4 Hz. The coarse mesh is stiffer than the calibrated default
-    // (measured: +3.8 % on the first mode, see docs/harmony.md): 5 % covers it, and a change
-    // of the model that moves the mode by more than the mesh error fails.
+    // (measured: 250.0 Hz, +5.2 % on the first mode, against 237.9 Hz at the default
+    // refinement, see docs/harmony.md): 6 % covers it, and a change of the model that moves the
+    // mode by more than the mesh error fails.
     assert!(stuck.len() >= 2, "axial modes found: {stuck:?}");
-    assert!((stuck[0] / 237.6 - 1.0).abs() < 0.05, "first axial mode {} Hz", stuck[0]);
+    assert!((stuck[0] / 237.6 - 1.0).abs() < 0.06, "first axial mode {} Hz", stuck[0]);
     assert!((stuck[1] / 878.4 - 1.0).abs() < 0.05, "second axial mode {} Hz", stuck[1]);
     // All blades slipping (contact connectors released vertically): the paper's asymptote near
-    // 190 Hz (Section 5.1); coarse mesh +4.9 %.
+    // 190 Hz (Section 5.1); coarse mesh 198.1 Hz, +4.3 %.
     let released = Design { contact_vertical_stiffness: 0.0, ..design };
     let (slipping, _) = axial_modes(&released, 6);
     assert!((slipping[0] / 190.0 - 1.0).abs() < 0.06, "all-slipping axial mode {} Hz", slipping[0]);
@@ -68,10 +76,10 @@ fn variant(v: BodyVariant) -> Design {
 #[test]
 fn coarse_envelope_substructure_has_the_paper_first_vertical_mode() {
     // Table 4: the envelope's first vertical mode, 880.4 Hz (test 889 Hz). Base plate and
-    // envelope on the shaker, coupled to it within 40 mm of the axis: the two bounce on the base
-    // plate's bending. Measured 889.7 Hz here, 889.4 Hz at the default refinement (+1.0 %); 3 %
-    // leaves room for the mesh, not for a change of the coupled zone (35 mm: 826 Hz, 45 mm:
-    // 927 Hz at the default refinement).
+    // envelope on the shaker, coupled to it within 37 mm of the axis: the two bounce on the base
+    // plate's bending. Measured 868.4 Hz here, 869.0 Hz at the default refinement (-1.3 %); 3 %
+    // leaves room for the mesh, not for a change of the coupled zone (39 mm: 897 Hz at the
+    // default refinement, the nodes of the next ring coupled).
     let nodes = [harmony::accelerometer(1), harmony::accelerometer(2), harmony::accelerometer(3)];
     let (f, z, mass) = modes(&Design::refined(0.5), Configuration::Envelope, 14, &nodes);
     assert!((mass - (9.47 + 44.88)).abs() < 5e-3 * 54.35, "base plate + envelope {mass} kg");
@@ -84,16 +92,47 @@ fn coarse_envelope_substructure_has_the_paper_first_vertical_mode() {
 }
 
 #[test]
+fn coarse_body_substructure_has_the_paper_synchronous_mode_and_four_blade_modes() {
+    // Table 4, central body + blades (clamped on the flange's circle, tips free): the first
+    // vertical mode with blades and body synchronous at 210.8 Hz (test 218.7 Hz), then four
+    // modes involving the blades asynchronously at 254-260 Hz (test 247-251.5 Hz). Measured
+    // here 219.3 Hz (+4.0 %) and 260.4, 261.6, 261.6, 269.5 Hz; at the default refinement
+    // 210.4 Hz (-0.2 %) and 257.3, 258.4, 258.4, 265.5 Hz (docs/harmony.md). 6 % and the band
+    // widened by 5 % cover the coarse mesh's stiffness (as the assembly's first mode, +5.2 %).
+    let nodes = [
+        harmony::accelerometer(0),
+        harmony::top_blade(1),
+        harmony::top_blade(2),
+        harmony::top_blade(3),
+        harmony::top_blade(4),
+    ];
+    let (f, z, mass) = modes(&Design::refined(0.5), Configuration::BodyWithBlades, 12, &nodes);
+    assert!((mass - (11.92 + 4.0 * 0.1086)).abs() < 1e-2 * 12.35, "body + blades {mass} kg");
+    // Synchronous: the body top and the four tips move up together.
+    let sync = (0..f.len())
+        .find(|&j| z[j][0].abs() > 0.1 && z[j][1..].iter().all(|t| t * z[j][0] > 0.0))
+        .expect("the synchronous axial mode");
+    assert!((f[sync] / 210.8 - 1.0).abs() < 0.06, "synchronous mode {} Hz", f[sync]);
+    // The next four: the blades' bending, the tips moving at least ten times the body top.
+    for j in sync + 1..sync + 5 {
+        assert!(f[j] > 0.95 * 254.0 && f[j] < 1.05 * 260.0, "blade mode {} Hz", f[j]);
+        let tip = z[j][1..].iter().map(|t| t.abs()).fold(0.0, f64::max);
+        assert!(tip > 10.0 * z[j][0].abs(), "mode {} Hz: tips {:?}, body top {}", f[j], &z[j][1..], z[j][0]);
+    }
+    assert!(f[sync + 5] > 400.0, "a fifth mode near the blades' at {} Hz", f[sync + 5]);
+}
+
+#[test]
 fn upright_blades_give_four_asynchronous_blade_modes_in_the_body_substructure() {
     // The variant of docs/harmony.md (not the default): Table 1's blade as a 65 mm high,
     // 118 mm long plate standing on edge (1.82 mm thick from its mass). Clamped body, free tips:
     // the blades' four tangential bending modes lie within 3 % of each other (paper: four modes
     // at 254-260 Hz; here ~285 Hz with the default screws), between the body's synchronous
     // axial mode and the top disk's modes.
-    let design = variant(BodyVariant { blade_height: Some(0.065), ..Default::default() });
+    let design = variant(BodyVariant { blade_height: Some(0.065), blade_rise: 0.0, ..Default::default() });
     let d = design.dimensions().unwrap();
     assert!((d.blade_width - 1.82e-3).abs() < 0.02e-3, "blade thickness {} m", d.blade_width);
-    let (f, z, mass) = modes(&design, Configuration::BodyWithBlades, 10, &[harmony::accelerometer(0)]);
+    let (f, z, mass) = modes(&design, Configuration::BodyWithBlades, 16, &[harmony::accelerometer(0)]);
     // 12.43 kg (+0.6 %, as the default design's body: the quadratic arcs and the diaphragm's
     // ring under the hub, counted once in the thickness from the mass).
     assert!((mass - (11.92 + 4.0 * 0.1086)).abs() < 1e-2 * 12.35, "body + blades {mass} kg");
@@ -120,7 +159,8 @@ fn optional_body_geometry_keeps_table_1_masses() {
             ..Default::default()
         },
         BodyVariant { top_disk_thickness: Some(0.004), rim_width: 0.02, ..Default::default() },
-        BodyVariant { blade_height: Some(0.065), ..Default::default() },
+        BodyVariant { blade_height: Some(0.065), blade_rise: 0.0, ..Default::default() },
+        BodyVariant { blade_rise: 0.0, body_flange_radius: None, top_disk_thickness: None, ..Default::default() },
     ]
     .map(variant);
     let table1 = 9.47 + 44.88 + 11.92 + 4.0 * 0.1086;
@@ -196,9 +236,9 @@ fn patch_tips_meet_the_wall_on_coincident_nodes_of_separate_bodies() {
     for i in 1..=4 {
         let tip = mesh.node_set(&format!("TIP_FACE_{i}")).unwrap();
         let wall = mesh.node_set(&format!("WALL_FACE_{i}")).unwrap();
-        // Hex20, 2 cells across the blade and 1 through its thickness: 3 × 2 corners, 4 + 3
-        // mid-edge nodes.
-        assert_eq!((tip.len(), wall.len()), (13, 13), "blade {i}");
+        // Hex20, 3 cells across the 65 mm blade and 1 through its thickness: 4 × 2 corners,
+        // 3 + 3 + 4 mid-edge nodes.
+        assert_eq!((tip.len(), wall.len()), (18, 18), "blade {i}");
         let blade = body[tip[0]];
         assert_ne!(blade, revolved);
         for &t in tip {
@@ -223,12 +263,15 @@ fn patch_tips_meet_the_wall_on_coincident_nodes_of_separate_bodies() {
                 mesh.nodes[partner[0]].id
             );
         }
-        // The patch pairing finds the same 13 pairs, with the tip face's area and a radial normal.
+        // The patch pairing finds the same 18 pairs, with the tip face's area and a radial normal.
         let patch = pair_sets(&mesh, &format!("TIP_FACE_{i}"), &format!("WALL_FACE_{i}"), None, None).unwrap();
-        assert_eq!(patch.pairs.len(), 13);
+        assert_eq!(patch.pairs.len(), 18);
+        // The tip face is shaped to the wall: its width is the arc 2 R asin(w / 2R) (+0.45 % on
+        // the 65 mm blade).
         let d = design.dimensions().unwrap();
-        let flat = d.blade_width * design.blade_thickness;
-        assert!((patch.area() - flat).abs() < 1e-3 * flat, "blade {i}: tip area {} m² vs {flat} m²", patch.area());
+        let r = d.envelope_inner_radius;
+        let arc = 2.0 * r * (0.5 * d.blade_width / r).asin() * design.blade_thickness;
+        assert!((patch.area() - arc).abs() < 1e-3 * arc, "blade {i}: tip area {} m² vs {arc} m²", patch.area());
         let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i - 1];
         assert!((patch.normal[0] - c).abs() < 1e-12 && (patch.normal[1] - s).abs() < 1e-12, "{:?}", patch.normal);
         // Named centre nodes: Top_Blade on the tip, Contact_Zone on the wall, at one position.

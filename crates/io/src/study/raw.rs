@@ -78,6 +78,10 @@ pub(crate) struct RawHarmony {
     pub shaker_zone_radius: Option<S<f64>>,
     pub connector_stiffness: Option<S<f64>>,
     pub screw_zone_radius: Option<S<f64>>,
+    pub screw_radii: Option<S<Vec<f64>>>,
+    pub blade_rise: Option<S<f64>>,
+    pub body_flange_radius: Option<S<f64>>,
+    pub top_disk_thickness: Option<S<f64>>,
     pub tip_contact: Option<S<String>>,
 }
 

@@ -476,6 +476,24 @@ fn harmony(src: &Source, h: &S<raw::RawHarmony>) -> Result<stickslip_fe::harmony
     if r.connector_stiffness.is_some() {
         d.contact_vertical_stiffness = d.connector_stiffness;
     }
+    if let Some(v) = &r.screw_radii {
+        let radii = finite_list(src, v, CTX, "screw_radii")?;
+        let [inner, outer] = radii[..] else {
+            return Err(
+                src.invalid(&v.span(), format!("{CTX}: screw_radii must give 2 radii (m), got {}", radii.len()))
+            );
+        };
+        d.screw_radii = [inner, outer];
+    }
+    if let Some(v) = &r.blade_rise {
+        d.variant.blade_rise = non_negative(src, v, CTX, "blade_rise", " m")?;
+    }
+    if let Some(v) = &r.body_flange_radius {
+        d.variant.body_flange_radius = Some(positive(src, v, CTX, "body_flange_radius", " m")?);
+    }
+    if let Some(v) = &r.top_disk_thickness {
+        d.variant.top_disk_thickness = Some(positive(src, v, CTX, "top_disk_thickness", " m")?);
+    }
     // Geometry that cannot be built, and refinements out of reach, are refused here, before
     // anything is meshed.
     let estimate = d.estimated_dofs().map_err(|e| src.invalid(&h.span(), format!("{CTX}: {e}")))?;
