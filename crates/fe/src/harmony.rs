@@ -629,6 +629,20 @@ impl Design {
         [along, across, 1 + (self.element_size < 0.01) as usize]
     }
 
+    /// The blocks of a blade along its length, root to tip: (start and end radius, rise over
+    /// the block, cells along). Flat, one block; with a rise, a flat block over the screws to the
+    /// bend and an inclined one from it to the wall, sharing the vertical face at the bend.
+    fn blade_segments(&self, d: &Dimensions) -> Vec<(f64, f64, f64, usize)> {
+        let (radius, rise) = (d.envelope_inner_radius, self.variant.blade_rise);
+        let root = radius - self.blade_length;
+        if rise == 0.0 {
+            return vec![(root, radius, 0.0, self.blade_cells(d)[0])];
+        }
+        let cells = |l: f64| ((l / (0.5 * self.element_size)).ceil() as usize).max(4);
+        let bend = self.blade_bend();
+        vec![(root, bend, 0.0, cells(bend - root)), (bend, radius, rise, cells((radius - bend).hypot(rise)))]
+    }
+
     /// A blade of [`TipContact::Patch`] along the unit vector `[c, s]`: the placed boxes of the
     /// connector model, but cut across at equal angles seen from the axis and ending on the
     /// wall's circle, so that each tip node lies on the wall at one of the angles that
@@ -637,23 +651,18 @@ impl Design {
     /// blade's volume. With a rise, a flat block to the bend and an inclined one from it.
     fn blade_on_wall(&self, d: &Dimensions, [c, s]: [f64; 2], disk_top: f64) -> Vec<Block> {
         let (radius, half, vertical) = (d.envelope_inner_radius, self.tip_half_angle(d), self.blade_vertical());
-        let (root, rise) = (radius - self.blade_length, self.variant.blade_rise);
-        let [along_cells, across, through] = self.blade_cells(d);
-        let cells = |l: f64| ((l / (0.5 * self.element_size)).ceil() as usize).max(4);
-        // (start radius, end radius or the wall's (None), rise over the block, cells along)
-        let segments = if rise > 0.0 {
-            let bend = self.blade_bend();
-            vec![(root, Some(bend), 0.0, cells(bend - root)), (bend, None, rise, cells((radius - bend).hypot(rise)))]
-        } else {
-            vec![(root, None, 0.0, along_cells)]
-        };
+        let [_, across, through] = self.blade_cells(d);
+        let segments = self.blade_segments(d);
+        let last = segments.len() - 1;
         segments
             .into_iter()
-            .map(|(start, end, up, n)| Block {
+            .enumerate()
+            .map(|(k, (start, end, up, n))| Block {
                 cells: [n, across, through],
                 map: Box::new(move |[u, v, w]| {
                     let angle = half * (2.0 * v - 1.0);
-                    let end = end.unwrap_or(radius * angle.cos());
+                    // The last block ends on the wall's circle.
+                    let end = if k == last { radius * angle.cos() } else { end };
                     let along = start + u * (end - start);
                     let across = radius * angle.sin();
                     [along * c - across * s, along * s + across * c, disk_top + u * up + w * vertical]
@@ -797,36 +806,27 @@ impl Design {
         // Blades along x, y, -x, -y: lying on the top disk, tip against the envelope wall.
         let mut blades = Vec::new();
         if with_body {
-            let root = d.envelope_inner_radius - self.blade_length;
+            let [_, across, through] = self.blade_cells(&d);
             for i in 0..4 {
                 let (c, s) = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][i];
                 let w = d.blade_width;
-                let origin = [root * c + 0.5 * w * s, root * s - 0.5 * w * c, disk_top];
-                let edges = [
-                    [self.blade_length * c, self.blade_length * s, 0.0],
-                    [-w * s, w * c, 0.0],
-                    [0.0, 0.0, self.blade_vertical()],
-                ];
                 let mut part = Part::new(&format!("BLADE_{}", i + 1), self.kind, tol)?;
-                let rise = self.variant.blade_rise;
                 if patch {
                     for block in self.blade_on_wall(&d, [c, s], disk_top) {
                         part.add_block(&block)?;
                     }
-                } else if rise > 0.0 {
-                    // Flat over the screws, then inclined up to the wall: two boxes sharing
-                    // the vertical face at the bend.
-                    let flat = self.blade_bend() - root;
-                    let inclined = d.envelope_inner_radius - self.blade_bend();
-                    let cells = |l: f64| ((l / (0.5 * self.element_size)).ceil() as usize).max(4);
-                    let [_, across, through] = self.blade_cells(&d);
-                    let flat_edges = [[flat * c, flat * s, 0.0], edges[1], edges[2]];
-                    part.add_block(&placed_box(origin, flat_edges, [cells(flat), across, through], "BLADES"))?;
-                    let bend = [origin[0] + flat * c, origin[1] + flat * s, disk_top];
-                    let up = [[inclined * c, inclined * s, rise], edges[1], edges[2]];
-                    part.add_block(&placed_box(bend, up, [cells(inclined.hypot(rise)), across, through], "BLADES"))?;
                 } else {
-                    part.add_block(&placed_box(origin, edges, self.blade_cells(&d), "BLADES"))?;
+                    let mut z = disk_top;
+                    for (start, end, up, n) in self.blade_segments(&d) {
+                        let origin = [start * c + 0.5 * w * s, start * s - 0.5 * w * c, z];
+                        let edges = [
+                            [(end - start) * c, (end - start) * s, up],
+                            [-w * s, w * c, 0.0],
+                            [0.0, 0.0, self.blade_vertical()],
+                        ];
+                        part.add_block(&placed_box(origin, edges, [n, across, through], "BLADES"))?;
+                        z += up;
+                    }
                 }
                 blades.push(part);
             }
