@@ -1,6 +1,6 @@
 //! Commands that chain: each consumes the previous one's files as written.
 mod common;
-use common::{columns, repo, scratch, stickslip};
+use common::{browser, columns, repo, scratch, stickslip};
 
 #[test]
 fn reduce_then_run_on_the_reduced_matrices_gives_the_study_with_its_own_reduction() {
@@ -113,7 +113,7 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     let study = on_reduced_matrices(&original).replace("levels = [0.5, 2.0, 5.0, 20.0]", "levels = [0.5]");
     assert!(study.contains("levels = [0.5]"));
     std::fs::write(dir.join("study.toml"), &study).unwrap();
-    ok(&[s("run"), s("--quiet"), s("--no-report"), s("--out"), path("run"), path("study.toml")]);
+    ok(&[s("run"), s("--quiet"), s("--out"), path("run"), path("study.toml")]);
     // The phase plot beside the amplitude plot of each output.
     for plot in ["frf_tip.png", "frf_phase_tip.png", "frf_phase_mid.png"] {
         assert!(dir.join("run").join(plot).exists(), "run wrote no {plot}");
@@ -196,6 +196,23 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     // Displacement and acceleration on their own axes.
     for plot in ["compare_level0_tip_disp.svg", "compare_level0_tip_accel.svg"] {
         assert!(dir.join("compare").join(plot).exists(), "compare wrote no {plot}");
+    }
+    // The comparison joins the run's report: its plots embedded in a "Test comparison"
+    // section, which a headless browser shows with the run's figures, without an error.
+    assert!(stdout.contains("(its test comparison section)"), "{stdout}");
+    let report = dir.join("run/report.html");
+    let html = std::fs::read_to_string(&report).unwrap();
+    assert_eq!(html.matches("<h2>Test comparison</h2>").count(), 1);
+    for plot in ["compare_level0_tip_disp.svg", "compare_level0_tip_accel.svg"] {
+        assert!(html.contains(&format!("<code>{plot}</code>")), "{plot} not in the report");
+    }
+    let images = html.matches("<img ").count();
+    assert!(html.contains(&format!("data-expected-figures=\"{images}\"")), "figure count");
+    if let Some(browser) = browser::required_browser() {
+        let dom = browser::dump_dom(&browser, &report, &dir.join("browser-profile"));
+        let all = format!("{images}/{images}");
+        assert_eq!(browser::body_attribute(&dom, "data-figures").as_deref(), Some(all.as_str()), "figures shown");
+        assert_eq!(browser::body_attribute(&dom, "data-errors").as_deref(), Some("0"), "script or console errors");
     }
     // The measured peak of the tip's displacement is the resonance `run` located: the middle
     // record sits on it, and the vertex of the parabola through three equally spaced records

@@ -3,65 +3,9 @@
 //!
 //! Without a browser the browser part prints a note and passes, unless STICKSLIP_REQUIRE_BROWSER=1
 //! (as in CI), where it fails.
-use std::io::Read;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
-
 mod common;
+use common::browser::{body_attribute, browser, dump_dom};
 use common::{repo, scratch, stickslip};
-
-/// The browser to use: `chromium` (or `chromium-browser`) on the PATH.
-fn browser() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser"]
-        .iter()
-        .flat_map(|name| std::env::split_paths(&path).map(move |dir| dir.join(name)))
-        .find(|candidate| candidate.is_file())
-}
-
-/// The DOM of `page` after its scripts ran, as the headless browser dumps it.
-fn dump_dom(browser: &Path, page: &Path, profile: &Path) -> String {
-    let mut child = Command::new(browser)
-        .args(["--headless", "--disable-gpu", "--no-sandbox", "--virtual-time-budget=5000", "--no-first-run"])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("--dump-dom")
-        .arg(format!("file://{}", page.display()))
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("start the browser");
-    let mut stdout = child.stdout.take().expect("browser stdout");
-    let reader = std::thread::spawn(move || {
-        let mut dom = String::new();
-        stdout.read_to_string(&mut dom).map(|_| dom)
-    });
-    let deadline = Instant::now() + Duration::from_secs(120);
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("wait for the browser") {
-            break status;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("the browser did not finish within 120 s on {}", page.display());
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
-    let dom = reader.join().expect("reader thread").expect("browser output");
-    assert!(status.success(), "the browser failed ({status}) on {}", page.display());
-    dom
-}
-
-/// The value of attribute `name` on the `<body>` tag of `dom`.
-fn body_attribute(dom: &str, name: &str) -> Option<String> {
-    let start = dom.find("<body")?;
-    let tag = &dom[start..start + dom[start..].find('>')?];
-    let key = format!("{name}=\"");
-    let from = tag.find(&key)? + key.len();
-    Some(tag[from..from + tag[from..].find('"')?].to_string())
-}
 
 #[test]
 fn the_report_of_the_1dof_example_shows_every_figure_in_a_headless_browser() {
@@ -116,19 +60,19 @@ fn the_report_of_the_1dof_example_shows_every_figure_in_a_headless_browser() {
     assert_eq!(body_attribute(&dom, "data-figures").as_deref(), Some(all.as_str()), "figures loaded");
     assert_eq!(body_attribute(&dom, "data-errors").as_deref(), Some("0"), "script errors");
 
-    // The check sees a broken figure and a script error: one image's data corrupted, one
-    // failing script added.
+    // The check sees a broken figure, a script error and a console error: one image's data
+    // corrupted, a failing script and one that logs an error added.
     let broken = out.join("broken.html");
     let corrupted = html.replacen("data:image/png;base64,", "data:image/png;base64,AAAA", 1).replacen(
         "</body>",
-        "<script>no_such_function();</script></body>",
+        "<script>no_such_function();</script><script>console.error('a console error');</script></body>",
         1,
     );
     std::fs::write(&broken, corrupted).unwrap();
     let dom = dump_dom(&browser, &broken, &profile);
     let one_missing = format!("{}/{}", figures.len() - 1, figures.len());
     assert_eq!(body_attribute(&dom, "data-figures").as_deref(), Some(one_missing.as_str()));
-    assert_eq!(body_attribute(&dom, "data-errors").as_deref(), Some("1"));
+    assert_eq!(body_attribute(&dom, "data-errors").as_deref(), Some("2"), "the script error and the console error");
     let _ = std::fs::remove_dir_all(&out);
 }
 

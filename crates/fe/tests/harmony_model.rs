@@ -1,6 +1,6 @@
 //! The generated Harmony-like assembly against the paper's figures (Tables 1, 3-5), at the
 //! coarse refinement that CI affords (element size 60 mm, ~31k DOFs). The default refinement
-//! (30 mm, ~66k DOFs) is calibrated to the paper; docs/harmony.md gives the mesh convergence and
+//! (30 mm, 63,700 DOFs) is calibrated to the paper; docs/harmony.md gives the mesh convergence and
 //! the substructures of Table 4.
 
 use stickslip_fe::assembly::FeModel;

@@ -35,6 +35,8 @@ fn levels(points: usize) -> Vec<LevelResult> {
             stick_fraction: value(i + 5).abs(),
             ..Default::default()
         }],
+        input_energy_j: 0.0,
+        viscous_energy_j: 0.0,
         stability: None,
     };
     // Four levels, as the Table 6 study.

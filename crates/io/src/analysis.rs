@@ -734,6 +734,8 @@ pub fn record(p: &PointResult, iterations: usize, residual: f64, time_data: bool
                 })
             })
             .collect(),
+        input_energy_j: p.excitation_work,
+        viscous_energy_j: p.viscous_dissipation,
         stability: None,
     }
 }

@@ -7,12 +7,14 @@
 //! Content-Security-Policy in the page forbids anything else.
 //!
 //! Sections: model (with its natural frequencies), sweep and levels, FRFs per output, peak table,
-//! harmonics, hysteresis loops and slider velocities, timings. Figures are sorted into sections
+//! harmonics, hysteresis loops and slider velocities, timings; `stickslip compare` adds a test
+//! comparison ([`with_comparison`]). Figures are sorted into sections
 //! by the file names of [`crate::plot`] (`frf_<out>`, `harmonics_level<i>_<out>`,
 //! `loop_level<i>_<el>`, `slider_level<i>_<el>`); other images go to a last section.
 //!
 //! A small inline script checks, on load, that every `<img>` decoded (`complete` and
-//! `naturalWidth > 0`) and counts script errors (`window.onerror`); it writes the result on the
+//! `naturalWidth > 0`) and counts script errors (`window.onerror`, unhandled rejections and
+//! `console.error` messages); it writes the result on the
 //! `<body>` as `data-figures="loaded/total"` and `data-errors="count"` (both `"unchecked"` until
 //! it runs), so that a headless browser's DOM dump verifies the page.
 
@@ -315,7 +317,11 @@ const SCRIPT: &str = "
   function show() {
     if (document.body) document.body.setAttribute('data-errors', String(errors));
   }
-  window.onerror = function () { errors += 1; show(); return false; };
+  function count() { errors += 1; show(); }
+  window.onerror = function () { count(); return false; };
+  window.addEventListener('unhandledrejection', count);
+  var consoleError = console.error;
+  console.error = function () { count(); return consoleError.apply(console, arguments); };
   window.addEventListener('load', function () {
     var images = document.images, loaded = 0;
     for (var i = 0; i < images.length; i++) {
@@ -607,6 +613,102 @@ fn figure_grid<'a>(
     }
 }
 
+/// A test comparison (`stickslip compare`): measured FRFs against the run's, shown in the run's
+/// report as its "Test comparison" section.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Comparison {
+    /// The measured files, as given.
+    pub measured: Vec<String>,
+    /// The overlay plots (PNG or SVG), embedded.
+    pub figures: Vec<PathBuf>,
+    pub peaks: Vec<ComparedPeak>,
+}
+
+/// A measured resonance peak and the nearest simulated one.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ComparedPeak {
+    pub level_n: f64,
+    pub output: String,
+    /// Unit of the amplitudes (`m_per_N`, `m_s_per_N`, `m_s2_per_N`).
+    pub unit: String,
+    /// The measured file (stem).
+    pub source: String,
+    pub measured_frequency_hz: f64,
+    pub measured_amplitude: f64,
+    /// NaN where the simulated curve has no peak.
+    pub simulated_frequency_hz: f64,
+    pub simulated_amplitude: f64,
+}
+
+const COMPARISON_BEGIN: &str = "<!-- test comparison -->\n";
+const COMPARISON_END: &str = "<!-- end of test comparison -->\n";
+
+/// The report page `page` with `comparison` as its "Test comparison" section, before the
+/// timings (replacing the one an earlier comparison put there), linked from the navigation; the
+/// page's count of expected figures follows. The page stays self-contained: the plots are
+/// embedded as the run's are.
+pub fn with_comparison(page: &str, comparison: &Comparison) -> Result<String, ReportError> {
+    let mut section = String::from(COMPARISON_BEGIN);
+    section.push_str("<section id=\"comparison\">\n<h2>Test comparison</h2>\n");
+    let files: Vec<String> = comparison.measured.iter().map(|m| format!("<code>{}</code>", escape(m))).collect();
+    let _ = writeln!(
+        section,
+        "<p>Measured FRFs ({}) against this run's, per level and output. Peaks: each measured resonance peak and the simulated peak nearest to it; errors are simulated − measured, relative to measured.</p>",
+        files.join(", ")
+    );
+    section.push_str("<table>\n<tr><th>level (N)</th><th>output</th><th>unit</th><th>measured</th><th>f measured (Hz)</th><th>f simulated (Hz)</th><th>Δf (%)</th><th>peak measured</th><th>peak simulated</th><th>error (%)</th></tr>\n");
+    for p in &comparison.peaks {
+        let df = 100.0 * (p.simulated_frequency_hz - p.measured_frequency_hz) / p.measured_frequency_hz;
+        let da = 100.0 * (p.simulated_amplitude - p.measured_amplitude) / p.measured_amplitude;
+        let _ = writeln!(
+            section,
+            "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            number(p.level_n),
+            escape(&p.output),
+            escape(&p.unit),
+            escape(&p.source),
+            fixed(p.measured_frequency_hz, 3),
+            fixed(p.simulated_frequency_hz, 3),
+            fixed(df, 2),
+            sig(p.measured_amplitude),
+            sig(p.simulated_amplitude),
+            fixed(da, 2),
+        );
+    }
+    section.push_str("</table>\n");
+    let figures = comparison
+        .figures
+        .iter()
+        .filter_map(|path| mime(path).map(|m| read_figure(path, m)))
+        .collect::<Result<Vec<_>, _>>()?;
+    figure_grid(&mut section, false, figures.iter(), |f| format!("Measured and simulated: {}", f.file_name));
+    section.push_str("</section>\n");
+    section.push_str(COMPARISON_END);
+
+    // An earlier comparison is replaced.
+    let mut page = match (page.find(COMPARISON_BEGIN), page.find(COMPARISON_END)) {
+        (Some(a), Some(b)) if a < b => format!("{}{}", &page[..a], &page[b + COMPARISON_END.len()..]),
+        _ => page.to_string(),
+    };
+    let at = page.find("<section id=\"timings\">").or_else(|| page.rfind("</body>")).unwrap_or(page.len());
+    page.insert_str(at, &section);
+    const TIMINGS_LINK: &str = "<a href=\"#timings\">";
+    if !page.contains("<a href=\"#comparison\">") {
+        if let Some(at) = page.find(TIMINGS_LINK) {
+            page.insert_str(at, "<a href=\"#comparison\">Test comparison</a>");
+        }
+    }
+    // The figure check expects every image of the page.
+    const EXPECTED: &str = "data-expected-figures=\"";
+    if let Some(from) = page.find(EXPECTED).map(|i| i + EXPECTED.len()) {
+        if let Some(len) = page[from..].find('"') {
+            let images = page.matches("<img ").count();
+            page.replace_range(from..from + len, &images.to_string());
+        }
+    }
+    Ok(page)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -813,6 +915,39 @@ mod tests {
         let dir = scratch("missing");
         let err = render(&data(&dir, &["frf_gone.png"])).unwrap_err();
         assert!(err.to_string().contains("frf_gone.png"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_test_comparison_joins_the_report_once_with_its_figures() {
+        let dir = scratch("comparison");
+        let plot = dir.join("compare_level0_mass_accel.png");
+        std::fs::write(&plot, PNG).unwrap();
+        let page = render(&ReportData { title: "t".into(), ..Default::default() }).unwrap();
+        assert!(page.contains("data-expected-figures=\"0\""));
+        let comparison = Comparison {
+            measured: vec!["test.uff".into()],
+            figures: vec![plot],
+            peaks: vec![ComparedPeak {
+                level_n: 70.0,
+                output: "mass".into(),
+                unit: "m_s2_per_N".into(),
+                source: "test".into(),
+                measured_frequency_hz: 238.0,
+                measured_amplitude: 1.0,
+                simulated_frequency_hz: 237.5,
+                simulated_amplitude: 1.1,
+            }],
+        };
+        let once = with_comparison(&page, &comparison).unwrap();
+        // A second comparison replaces the first.
+        assert_eq!(with_comparison(&once, &comparison).unwrap(), once);
+        assert_eq!(once.matches("<h2>Test comparison</h2>").count(), 1);
+        assert_eq!(once.matches("<a href=\"#comparison\">").count(), 1);
+        assert!(once.contains("data-expected-figures=\"1\"") && once.contains("data:image/png;base64,"));
+        // Errors relative to measured: −0.21 % in frequency, +10 % in amplitude.
+        assert!(once.contains("<td class=\"num\">-0.21</td>") && once.contains("<td class=\"num\">10.00</td>"));
+        assert!(once.find("id=\"comparison\"").unwrap() < once.find("id=\"timings\"").unwrap());
         let _ = std::fs::remove_dir_all(&dir);
     }
 

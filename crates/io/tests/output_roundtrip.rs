@@ -48,6 +48,8 @@ fn point(f: f64, seed: usize, n_t: usize) -> PointRecord {
             loop_force: series(seed + 3),
             slider_velocity: series(seed + 4),
         }],
+        input_energy_j: value(seed + 7),
+        viscous_energy_j: value(seed + 8),
         stability: Some(PointStability {
             stable: seed.is_multiple_of(2),
             exponent_re: value(seed + 5),
@@ -99,11 +101,19 @@ fn frf_csv_reads_back_exactly() {
     assert_eq!(&header[4..7], ["mass_disp_frf_m_per_N", "mass_accel_frf_m_s2_per_N", "mass_peak_m"]);
     assert_eq!(&header[7..9], ["mass_h0_amp_m", "mass_h0_phase_rad"]);
     assert_eq!(
-        &header[header.len() - 4..],
-        ["joint_1_stick_fraction", "stable", "floquet_re_per_s", "floquet_im_rad_per_s"]
+        &header[header.len() - 6..],
+        [
+            "joint_1_stick_fraction",
+            "input_energy_J",
+            "viscous_energy_J",
+            "stable",
+            "floquet_re_per_s",
+            "floquet_im_rad_per_s"
+        ]
     );
-    // 4 + per output 3 + 2 (N+1) with N = 7, + 2 per element, + 3 for the stability.
-    assert_eq!(header.len(), 4 + 2 * (3 + 16) + 2 + 3);
+    // 4 + per output 3 + 2 (N+1) with N = 7, + 2 per element, + 2 energies, + 3 for the
+    // stability.
+    assert_eq!(header.len(), 4 + 2 * (3 + 16) + 2 + 2 + 3);
     assert_eq!(header, frf_columns(&levels[0].points[0]));
     assert_eq!(rows.len(), 8);
     let mut r = 0;
@@ -117,7 +127,8 @@ fn frf_csv_reads_back_exactly() {
             assert_eq!(row[4], p.outputs[0].disp_frf);
             assert_eq!(row[7 + 2 * 5], p.outputs[0].harmonics[5].0);
             assert_eq!(row[7 + 2 * 5 + 1], p.outputs[0].harmonics[5].1);
-            assert_eq!(row[header.len() - 5], p.elements[0].energy_j);
+            assert_eq!(row[header.len() - 7], p.elements[0].energy_j);
+            assert_eq!(row[header.len() - 5..header.len() - 3], [p.input_energy_j, p.viscous_energy_j]);
             let stability = p.stability.unwrap();
             assert_eq!(
                 row[header.len() - 3..],

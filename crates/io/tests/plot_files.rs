@@ -54,6 +54,8 @@ fn levels() -> Vec<LevelResult> {
                             loop_force,
                             slider_velocity,
                         }],
+                        input_energy_j: 0.0,
+                        viscous_energy_j: 0.0,
                         stability: None,
                     }
                 })

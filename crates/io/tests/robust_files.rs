@@ -70,6 +70,8 @@ fn writers_refuse_non_finite_values_naming_the_quantity_and_where() {
             vel: vec![0.0, 1.0],
         }],
         elements: vec![],
+        input_energy_j: 0.0,
+        viscous_energy_j: 0.0,
         stability: None,
     };
     let levels = vec![LevelResult {

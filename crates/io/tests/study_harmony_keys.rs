@@ -53,3 +53,30 @@ fn geometry_keys_that_cannot_be_built_are_refused_naming_the_key() {
         assert!(message.contains("[model.harmony]") && message.contains(expected), "{keys}: {message}");
     }
 }
+
+#[test]
+fn a_refinement_beyond_memory_is_refused_with_its_estimate_before_meshing() {
+    let text = example().replace("refinement = 1.0", "refinement = 4.0");
+    let message = Study::parse(&text, "study.toml").map(|_| ()).unwrap_err().to_string();
+    println!("{message}");
+    assert!(message.starts_with("study.toml:") && message.contains("[model.harmony]"), "{message}");
+    // The estimate, in DOFs and GiB, and what to change.
+    assert!(message.contains("refinement 4 would make about") && message.contains("GiB"), "{message}");
+    assert!(message.contains("lower `refinement`"), "{message}");
+}
+
+#[test]
+fn a_joint_on_a_node_outside_the_mesh_is_refused_before_the_modes() {
+    // The coarse mesh, with blade 2's contact on a node the mesh does not have.
+    let text = example()
+        .replace("refinement = 1.0", "refinement = 0.5")
+        .replace("between = [\"12.3\", \"22.3\"]", "between = [\"12.3\", \"99999.3\"]");
+    let study = Study::parse(&text, "study.toml").unwrap();
+    let mut stages = Vec::new();
+    let message = study.build_model_timed(&mut stages).map(|_| ()).unwrap_err().to_string();
+    println!("{message}");
+    assert!(message.contains("[[joint]] \"blade2\"") && message.contains("99999.3"), "{message}");
+    // Refused after the mesh and its assembly, before the modes and the reduction.
+    let names: Vec<&str> = stages.iter().map(|(s, _)| s.as_str()).collect();
+    assert_eq!(names, ["mesh", "assembly"], "{message}");
+}

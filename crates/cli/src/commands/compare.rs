@@ -1,7 +1,8 @@
 //! `stickslip compare`: measured against simulated FRFs (paper Section 5.1), per force level,
 //! output and quantity an overlay plot of the amplitudes (`compare_level<i>_<out>_<disp|vel|accel>`)
 //! and a table of the resonance peaks (frequency, amplitude and their errors), on stdout and as
-//! `peaks.csv`.
+//! `peaks.csv`; the same, with the plots, as the "Test comparison" section of the run's
+//! `report.html` (`--no-report`: not).
 //!
 //! Measured FRFs: CSV (`[level_N,]frequency_Hz,<name>_amp_<unit>[,<name>_phase_rad]`, as
 //! `stickslip extract` writes them) or UFF 58 (function type 4). A curve in `m_s2_per_N` is
@@ -18,6 +19,7 @@ use anyhow::{bail, Context, Result};
 use stickslip_core::signal::peaks::{peaks, Peak};
 use stickslip_io::plot::{self, MeasuredCurve};
 use stickslip_io::records::{self, FrfCurve, FrfSet};
+use stickslip_io::report;
 use stickslip_io::uff;
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -53,6 +55,10 @@ pub struct Args {
     /// Plot file format (PNG needs a system font).
     #[arg(long, value_enum, default_value = "svg")]
     pub plot_format: PlotFormat,
+    /// Leave the run's report alone (by default the comparison becomes the "Test comparison"
+    /// section of `report.html` beside the simulated table, when there is one).
+    #[arg(long)]
+    pub no_report: bool,
 }
 
 /// Relative tolerance when matching a measured level to a simulated one: levels identified by
@@ -269,6 +275,30 @@ pub fn main(args: Args) -> Result<()> {
     written.push(csv_path);
     for old in stickslip_io::output::replace_previous_run(&args.out, "compare", &written)? {
         println!("removed {} (written by the previous compare, not by this one)", old.display());
+    }
+    let report = sim_path.with_file_name(report::REPORT_FILE);
+    if !args.no_report && report.is_file() {
+        let comparison = report::Comparison {
+            measured: args.measured.iter().map(|m| m.display().to_string()).collect(),
+            figures: written.iter().filter(|p| p.extension().is_some_and(|e| e == ext)).cloned().collect(),
+            peaks: rows
+                .iter()
+                .map(|r| report::ComparedPeak {
+                    level_n: r.level_n,
+                    output: r.output.clone(),
+                    unit: r.unit.clone(),
+                    source: r.source.clone(),
+                    measured_frequency_hz: r.measured.frequency_hz,
+                    measured_amplitude: r.measured.amplitude,
+                    simulated_frequency_hz: r.simulated.map_or(f64::NAN, |p| p.frequency_hz),
+                    simulated_amplitude: r.simulated.map_or(f64::NAN, |p| p.amplitude),
+                })
+                .collect(),
+        };
+        let page = std::fs::read_to_string(&report).with_context(|| format!("reading {}", report.display()))?;
+        let page = report::with_comparison(&page, &comparison)?;
+        std::fs::write(&report, page).with_context(|| format!("writing {}", report.display()))?;
+        println!("report: {} (its test comparison section)", report.display());
     }
     Ok(())
 }

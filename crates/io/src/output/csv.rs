@@ -20,6 +20,7 @@ pub fn frf_columns(template: &PointRecord) -> Vec<String> {
     for e in &template.elements {
         cols.extend([format!("{}_energy_J", e.name), format!("{}_stick_fraction", e.name)]);
     }
+    cols.extend(["input_energy_J", "viscous_energy_J"].map(String::from));
     if template.stability.is_some() {
         cols.extend(["stable", "floquet_re_per_s", "floquet_im_rad_per_s"].map(String::from));
     }
@@ -38,6 +39,7 @@ pub fn frf_row(level_n: f64, p: &PointRecord) -> Vec<f64> {
     for e in &p.elements {
         row.extend([e.energy_j, e.stick_fraction]);
     }
+    row.extend([p.input_energy_j, p.viscous_energy_j]);
     if let Some(s) = &p.stability {
         row.extend([f64::from(u8::from(s.stable)), s.exponent_re, s.exponent_im]);
     }

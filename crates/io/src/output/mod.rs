@@ -66,6 +66,11 @@ pub struct PointRecord {
     pub residual: f64,
     pub outputs: Vec<OutputRecord>,
     pub elements: Vec<ElementRecord>,
+    /// Work of the excitation per cycle (J): the energy the force puts in, which the joints
+    /// (`ElementRecord::energy_j`) and the viscous damping dissipate at a periodic solution.
+    pub input_energy_j: f64,
+    /// Energy dissipated per cycle by the viscous damping (J).
+    pub viscous_energy_j: f64,
     /// Stability by Hill's method, when the study asks for it (`stability = true`).
     pub stability: Option<PointStability>,
 }

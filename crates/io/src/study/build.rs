@@ -198,6 +198,7 @@ impl Study {
         // joints and outputs name DOFs of the full model and are projected (Eqs. 7-8:
         // u = Vᵀ U = (Tᵀ V)ᵀ q).
         let full_dofs = full.linear().dofs.clone();
+        self.check_placements(&full_dofs)?;
         let started = std::time::Instant::now();
         let (patches, patch_dofs) = self.contact_patches(full.fe_mut())?;
         if !patches.is_empty() {
@@ -216,6 +217,25 @@ impl Study {
             }
         };
         Ok(LinearBase { full_dofs, linear, reduction, model_at, part: self.linear_part(), patches })
+    }
+
+    /// Every DOF that a load, joint or output names exists in the full model, and every vector
+    /// has its size: checked before the modes and the reduction, which take minutes at the
+    /// paper's size, so that a misspelt DOF is reported at once (the same error as later).
+    fn check_placements(&self, full_dofs: &[DofLabel]) -> Result<(), StudyError> {
+        let space = DofSpace { dofs: full_dofs, reduction: None };
+        let placements = (self.loads.iter().map(|l| (&l.placement, format!("[[load]] {:?}", l.name), l.at)))
+            .chain(self.joints.iter().map(|j| (&j.placement, format!("[[joint]] {:?}", j.name), j.at)))
+            .chain(self.outputs.iter().map(|o| (&o.placement, format!("[[output]] {:?}", o.name), o.at)));
+        for (placement, ctx, at) in placements {
+            let found = match placement {
+                Placement::Dof(a) => space.index(a, &ctx).map(drop),
+                Placement::Between(a, b) => space.index(a, &ctx).and_then(|_| space.index(b, &ctx)).map(drop),
+                Placement::Vector(_) => full_vector(&space, placement, &ctx).map(drop),
+            };
+            found.map_err(|kind| self.error(Some(at), kind))?;
+        }
+        Ok(())
     }
 
     /// The nonlinear model, excitation and outputs of this study on a linear base built by a
