@@ -14,7 +14,7 @@ use stickslip_core::hbm::{
     HillSettings, Jacobians, Stability,
 };
 use stickslip_core::model::NonlinearModel;
-use stickslip_core::post::{evaluate_point, point_result, OutputSelector, PointResult};
+use stickslip_core::post::{evaluate_point, point_result, point_result_with, OutputSelector, PointResult, TimeSeries};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
@@ -23,6 +23,9 @@ struct Taken<'h> {
     hill: &'h Hill,
     outputs: Vec<OutputSelector>,
     results: Vec<PointResult>,
+    /// The same without the time series, as a run makes the points whose time data it does
+    /// not keep.
+    summaries: Vec<PointResult>,
     stabilities: Vec<Stability>,
     jacobians: Vec<(Mat<f64>, Vec<f64>)>,
     tests: Vec<TestFunctions>,
@@ -39,6 +42,7 @@ impl<'a, 'm> PointObserver<FrequencySweep<'a, 'm>> for Taken<'_> {
         let (x, omega) = (accepted.point().x.clone(), accepted.point().lambda);
         let hbm = &mut *accepted.problem().hbm;
         self.results.push(point_result(hbm, &x, &self.outputs).unwrap());
+        self.summaries.push(point_result_with(hbm, &x, &self.outputs, TimeSeries::Skipped).unwrap());
         self.stabilities.push(stability_at_last_evaluation(hbm, self.hill, &x, omega).unwrap());
     }
 }
@@ -65,6 +69,7 @@ fn check(model: &NonlinearModel, force: &[f64], level: f64, band_hz: (f64, f64))
         hill: &hill,
         outputs: outputs.clone(),
         results: Vec::new(),
+        summaries: Vec::new(),
         stabilities: Vec::new(),
         jacobians: Vec::new(),
         tests: Vec::new(),
@@ -95,6 +100,26 @@ fn check(model: &NonlinearModel, force: &[f64], level: f64, band_hz: (f64, f64))
             assert_eq!(a.force, b.force, "point {i}");
         }
         slips += usize::from(got.elements.iter().any(|e| e.stick_fraction < 1.0));
+        // Without the time series: every other value the same, bit for bit, the series empty
+        // (one per element direction).
+        let summary = &taken.summaries[i];
+        assert_eq!(
+            (summary.excitation_work, summary.viscous_dissipation),
+            (got.excitation_work, got.viscous_dissipation)
+        );
+        for (a, b) in summary.outputs.iter().zip(&got.outputs) {
+            assert_eq!((&a.coeffs, a.peak), (&b.coeffs, b.peak), "point {i}");
+            assert!(a.displacement.is_empty() && a.velocity.is_empty() && !b.velocity.is_empty());
+        }
+        for (a, b) in summary.elements.iter().zip(&got.elements) {
+            assert_eq!((a.energy_per_cycle, a.stick_fraction), (b.energy_per_cycle, b.stick_fraction), "point {i}");
+            assert_eq!(a.direction_energy, b.direction_energy, "point {i}");
+            assert_eq!(
+                (a.displacement.len(), a.force.len(), a.slider_velocity.len()),
+                (b.force.len(), b.force.len(), b.force.len())
+            );
+            assert!(a.displacement.iter().chain(&a.force).chain(&a.slider_velocity).all(Vec::is_empty));
+        }
 
         // The Jacobian completed from the converged residual against a full evaluation: the
         // sliders' closed form from the same slip flags and the same matrices H_k, so the same

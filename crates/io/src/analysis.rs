@@ -23,7 +23,7 @@ use stickslip_core::hbm::{
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{
-    evaluate_dlft_point, evaluate_point, output_amplitude, point_result, OutputSelector, PointResult,
+    evaluate_dlft_point, evaluate_point, output_amplitude, point_result_with, OutputSelector, PointResult, TimeSeries,
 };
 
 use crate::output::{
@@ -448,7 +448,7 @@ impl<'a> LevelSweeper<'a> {
 
 /// The record of each point of a level (its stability, when asked, and the test functions of
 /// folds and branch points) made as the continuation accepts it. For the penalty balance from
-/// the evaluation that converged there (core [`point_result`],
+/// the evaluation that converged there (core [`point_result_with`], its time series where kept;
 /// [`stability_at_last_evaluation`]): nothing is evaluated again after the branch. Progress
 /// goes on to the caller's observer.
 struct PointRecorder<'s, O: ?Sized> {
@@ -507,8 +507,13 @@ impl<O: Observer + ?Sized> PointRecorder<'_, O> {
 impl<'a, 'm, O: Observer + ?Sized> PointObserver<FrequencySweep<'a, 'm>> for PointRecorder<'_, O> {
     fn on_accepted(&mut self, accepted: &mut Accepted<'_, FrequencySweep<'a, 'm>>) {
         let (hill, selectors) = (self.hill, self.selectors);
+        // The time series only where the point's time data is kept.
+        let series = match self.study.output_options.time_data.keeps(self.points.len()) {
+            true => TimeSeries::Kept,
+            false => TimeSeries::Skipped,
+        };
         self.record(accepted, |problem, x, omega| {
-            let result = point_result(problem.hbm, x, selectors)?;
+            let result = point_result_with(problem.hbm, x, selectors, series)?;
             let stability = hill.map(|hill| stability_at_last_evaluation(problem.hbm, hill, x, omega)).transpose()?;
             Ok((result, stability))
         });

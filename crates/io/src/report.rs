@@ -619,8 +619,8 @@ fn figure_grid<'a>(
 pub struct Comparison {
     /// The measured files, as given.
     pub measured: Vec<String>,
-    /// The overlay plots (PNG or SVG), embedded.
-    pub figures: Vec<PathBuf>,
+    /// The overlay plots (PNG or SVG), embedded, with their captions.
+    pub figures: Vec<(PathBuf, String)>,
     pub peaks: Vec<ComparedPeak>,
 }
 
@@ -676,12 +676,13 @@ pub fn with_comparison(page: &str, comparison: &Comparison) -> Result<String, Re
         );
     }
     section.push_str("</table>\n");
-    let figures = comparison
-        .figures
-        .iter()
-        .filter_map(|path| mime(path).map(|m| read_figure(path, m)))
-        .collect::<Result<Vec<_>, _>>()?;
-    figure_grid(&mut section, false, figures.iter(), |f| format!("Measured and simulated: {}", f.file_name));
+    let mut figures = Vec::with_capacity(comparison.figures.len());
+    for (path, caption) in &comparison.figures {
+        if let Some(m) = mime(path) {
+            figures.push(Figure { subject: caption.clone(), ..read_figure(path, m)? });
+        }
+    }
+    figure_grid(&mut section, false, figures.iter(), |f| f.subject.clone());
     section.push_str("</section>\n");
     section.push_str(COMPARISON_END);
 
@@ -927,7 +928,7 @@ mod tests {
         assert!(page.contains("data-expected-figures=\"0\""));
         let comparison = Comparison {
             measured: vec!["test.uff".into()],
-            figures: vec![plot],
+            figures: vec![(plot, "mass at 70 N, acceleration".into())],
             peaks: vec![ComparedPeak {
                 level_n: 70.0,
                 output: "mass".into(),

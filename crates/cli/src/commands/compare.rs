@@ -260,11 +260,22 @@ pub fn main(args: Args) -> Result<()> {
         );
     }
     let mut written = Vec::new();
+    // The plots with their captions in the run's report.
+    let mut figures = Vec::new();
     for g in &groups {
         let plot = args.out.join(format!("compare_level{}_{}_{}.{ext}", g.level_index, g.output, g.quantity));
         let title = format!("{} at {} N: measured and simulated", g.output, g.level_n);
         plot::plot_comparison(&plot, &title, &g.unit, &g.simulated, &g.measured)?;
         println!("wrote {}", plot.display());
+        let quantity = match g.quantity {
+            "disp" => "displacement",
+            "vel" => "velocity",
+            _ => "acceleration",
+        };
+        figures.push((
+            plot.clone(),
+            format!("{} at {} N, {quantity} FRF: measured (markers) and simulated", g.output, g.level_n),
+        ));
         written.push(plot);
     }
     let (table, csv) = peak_table(&rows);
@@ -280,7 +291,7 @@ pub fn main(args: Args) -> Result<()> {
     if !args.no_report && report.is_file() {
         let comparison = report::Comparison {
             measured: args.measured.iter().map(|m| m.display().to_string()).collect(),
-            figures: written.iter().filter(|p| p.extension().is_some_and(|e| e == ext)).cloned().collect(),
+            figures,
             peaks: rows
                 .iter()
                 .map(|r| report::ComparedPeak {

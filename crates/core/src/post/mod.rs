@@ -131,6 +131,27 @@ pub fn output_amplitude(
 /// read as that evaluation left them, not computed again. An error if the last evaluation
 /// was not at `x`.
 pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector]) -> Result<PointResult, HbmError> {
+    point_result_with(hbm, x, outputs, TimeSeries::Kept)
+}
+
+/// Whether a [`PointResult`] carries the time series over the period (outputs' displacement and
+/// velocity, the elements' displacement, force and slider velocity) or only what a table of
+/// points needs (harmonics, peak, energies, stick fractions), which the series would otherwise
+/// cost several times over at every point of a sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeSeries {
+    Kept,
+    /// The series are left empty; every other value is the same, bit for bit.
+    Skipped,
+}
+
+/// [`point_result`], with the time series kept or skipped.
+pub fn point_result_with(
+    hbm: &CondensedHbm<'_>,
+    x: &[f64],
+    outputs: &[OutputSelector],
+    series: TimeSeries,
+) -> Result<PointResult, HbmError> {
     let Some((omega, level)) = hbm.last_evaluation().filter(|&(w, l)| hbm.evaluated_at(x, w, l)) else {
         return Err(HbmError::NotEvaluated);
     };
@@ -142,24 +163,27 @@ pub fn point_result(hbm: &CondensedHbm<'_>, x: &[f64], outputs: &[OutputSelector
         let aft = hbm.element_aft(e);
         let law = site.law.as_ref();
         // The joint's own force: f = g + K_r u (Eq. 11).
-        let force = (0..d * nt)
-            .map(|i| {
-                let (a, j) = (i / nt, i % nt);
-                aft.g[i] + (0..d).map(|b| law.replaced_stiffness(a, b) * aft.u[b * nt + j]).sum::<f64>()
-            })
-            .collect();
+        let force = match series {
+            TimeSeries::Kept => (0..d * nt)
+                .map(|i| {
+                    let (a, j) = (i / nt, i % nt);
+                    aft.g[i] + (0..d).map(|b| law.replaced_stiffness(a, b) * aft.u[b * nt + j]).sum::<f64>()
+                })
+                .collect(),
+            TimeSeries::Skipped => Vec::new(),
+        };
         elements.push(ElementSamples {
             name: &site.name,
             offset,
             dirs: d,
-            displacement: aft.u.clone(),
+            displacement: if series == TimeSeries::Kept { aft.u.clone() } else { Vec::new() },
             force,
             slipping: &aft.slipping,
         });
         offset += d;
     }
     let linear = Linear { receptance: hbm.receptance(), force: hbm.force(), plan: hbm.plan(), q: hbm.n_directions() };
-    Ok(recovered_result(&linear, x, hbm.element_force_harmonics(), omega, level, outputs, elements))
+    Ok(recovered_result(&linear, x, hbm.element_force_harmonics(), omega, level, outputs, elements, series))
 }
 
 /// Post-process a converged solution `x` of the DLFT balance at (Ω, λ_F) as
@@ -202,7 +226,7 @@ pub fn evaluate_dlft_point(
         offset += d;
     }
     let linear = Linear { receptance: dlft.receptance(), force: dlft.force(), plan, q };
-    Ok(recovered_result(&linear, x, dlft.contact_forces(), omega, level, outputs, elements))
+    Ok(recovered_result(&linear, x, dlft.contact_forces(), omega, level, outputs, elements, TimeSeries::Kept))
 }
 
 /// The linear part of a balance, which recovers outputs from the forces on its q directions.
@@ -227,7 +251,10 @@ struct ElementSamples<'a> {
 
 /// The results at a point of relative displacement harmonics `x` and force harmonics `g` on
 /// the q directions (coefficient-major), whatever balance found them: outputs and the
-/// excitation's work by recovery (Eq. 27), energies from the harmonics, loops from the samples.
+/// excitation's work by recovery (Eq. 27), energies from the harmonics, loops from the samples
+/// (with [`TimeSeries::Skipped`] the outputs' displacement is synthesised for its peak only, and
+/// no series is kept).
+#[allow(clippy::too_many_arguments)]
 fn recovered_result(
     linear: &Linear<'_>,
     x: &[f64],
@@ -236,7 +263,9 @@ fn recovered_result(
     level: f64,
     outputs: &[OutputSelector],
     elements: Vec<ElementSamples<'_>>,
+    series: TimeSeries,
 ) -> PointResult {
+    let kept = series == TimeSeries::Kept;
     let (q, plan, receptance) = (linear.q, linear.plan, linear.receptance);
     let (nh, nc, nt) = (plan.n_harmonics(), plan.n_coeffs(), plan.n_samples());
     let pi = std::f64::consts::PI;
@@ -270,11 +299,17 @@ fn recovered_result(
     let mut output_results = Vec::with_capacity(outputs.len());
     for (o, c) in outputs.iter().zip(&coeffs) {
         let mut displacement = vec![0.0; nt];
-        let mut velocity = vec![0.0; nt];
         plan.synthesize(c, &mut displacement, &mut scratch);
-        plan.synthesize_derivative(c, &mut velocity, &mut scratch);
-        velocity.iter_mut().for_each(|v| *v *= omega);
         let peak = displacement.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let velocity = if kept {
+            let mut velocity = vec![0.0; nt];
+            plan.synthesize_derivative(c, &mut velocity, &mut scratch);
+            velocity.iter_mut().for_each(|v| *v *= omega);
+            velocity
+        } else {
+            displacement = Vec::new();
+            Vec::new()
+        };
         output_results.push(OutputResult { name: o.name.clone(), coeffs: c.clone(), displacement, velocity, peak });
     }
 
@@ -292,13 +327,23 @@ fn recovered_result(
                     .sum()
             })
             .collect();
-        let displacement: Vec<Vec<f64>> = e.displacement.chunks(nt).map(<[f64]>::to_vec).collect();
-        let force: Vec<Vec<f64>> = e.force.chunks(nt).map(<[f64]>::to_vec).collect();
+        // One series per direction, empty when skipped.
+        let per_direction = |samples: &[f64]| -> Vec<Vec<f64>> {
+            if kept {
+                samples.chunks(nt).map(<[f64]>::to_vec).collect()
+            } else {
+                vec![Vec::new(); d]
+            }
+        };
+        let (displacement, force) = (per_direction(&e.displacement), per_direction(&e.force));
         // The velocity samples as the AFT computes them, Ω du/dθ (it skips them for the
         // rate-independent laws, whose update never reads them).
-        let mut rate = vec![0.0; nt];
+        let mut rate = vec![0.0; if kept { nt } else { 0 }];
         let slider_velocity = (0..d)
             .map(|a| {
+                if !kept {
+                    return Vec::new();
+                }
                 let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
                 plan.synthesize_derivative(&coeffs, &mut rate, &mut scratch);
                 (0..nt).map(|j| if e.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
