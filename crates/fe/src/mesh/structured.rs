@@ -16,6 +16,41 @@
 //! the axis. Around the axis the body is cut into equal sectors, or at given angles
 //! ([`QuarterAngles`]) where another part must find nodes of the body at its own nodes' angles
 //! (a blade tip against a wall, meshed as a conforming contact interface).
+//!
+//! The Harmony model ([`crate::harmony`]) is built from these pieces; so is a user's own part.
+//! A casing, a wall standing on a bottom flange (two rectangles of one profile, which share
+//! the nodes of their common edge), meshed in hex20 and assembled:
+//!
+//! ```
+//! use stickslip_fe::assembly::FeModel;
+//! use stickslip_fe::element::SolidKind;
+//! use stickslip_fe::mesh::structured::{revolve, Part, ProfileRect};
+//! use stickslip_fe::mesh::{Material, Mesh};
+//!
+//! let steel = Material { young: 210e9, poisson: 0.3, density: 7800.0 };
+//! let mut casing = Part::new("CASING", SolidKind::Hex20, 1e-9).unwrap();
+//! // Profile in the (r, z) half-plane (m): the flange, then the wall on its inner edge.
+//! let profile = [
+//!     ProfileRect { r: [0.10, 0.16], z: [0.00, 0.01], elset: "FLANGE".into() },
+//!     ProfileRect { r: [0.10, 0.11], z: [0.01, 0.21], elset: "WALL".into() },
+//! ];
+//! revolve(&mut casing, &profile, 32, 0.02).unwrap();
+//! let clamp = casing.nodes_where(|[_, _, z]| z == 0.0);
+//! let mut mesh = Mesh::default();
+//! let ids: Vec<u64> = (1..=casing.nodes.len() as u64).collect();
+//! let materials = [("FLANGE", "STEEL", steel.clone()), ("WALL", "STEEL", steel)];
+//! let index = casing.add_to(&mut mesh, &ids, 1, &materials).unwrap();
+//! mesh.fixed = clamp.iter().flat_map(|&n| [1, 2, 3].map(|d| (index[n], d))).collect();
+//! let fe = FeModel::assemble(mesh).unwrap();
+//! // The mass of the exact geometry: the arcs are quadratic between the nodes of hex20.
+//! let pi = std::f64::consts::PI;
+//! let volume = pi * (0.16f64.powi(2) - 0.10f64.powi(2)) * 0.01 + pi * (0.11f64.powi(2) - 0.10f64.powi(2)) * 0.20;
+//! assert!((fe.solid_mass / (7800.0 * volume) - 1.0).abs() < 1e-3, "{} kg", fe.solid_mass);
+//! ```
+//!
+//! `crate::harmony` adds placed boxes (its blades) the same way ([`Part::add_block`],
+//! [`placed_box`]), writes every part into one [`Mesh`] with its own node ids, and joins parts
+//! with couplings and connectors; `mesh::inp_writer` and `mesh::gmsh_writer` write the result.
 
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
