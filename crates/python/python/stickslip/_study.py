@@ -104,7 +104,8 @@ class Results:
 
     @property
     def residual(self) -> np.ndarray:
-        """Final Newton residual of each point, relative to the solution's norm."""
+        """Final Newton residual of each point, relative to the linear response at the band's
+        start (the measure of the study's `tolerance`; docs/study-file.md)."""
         return self.column("residual_rel")
 
     def amplitudes(self, output: str) -> np.ndarray:
@@ -121,6 +122,17 @@ class Results:
 
     def stick_fraction(self, element: str) -> np.ndarray:
         return self.column(f"{element}_stick_fraction")
+
+    @property
+    def input_energy(self) -> np.ndarray:
+        """Work of the excitation per cycle (J), one value per point."""
+        return self.column("input_energy_J")
+
+    @property
+    def viscous_energy(self) -> np.ndarray:
+        """Energy dissipated per cycle by the viscous damping (J), one value per point: with the
+        joints' `energy`, it balances `input_energy` at a converged point."""
+        return self.column("viscous_energy_J")
 
     def level(self, index: int) -> "Results":
         """The points of one level (by its index in the study's levels)."""
