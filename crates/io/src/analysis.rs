@@ -846,7 +846,7 @@ pub fn report_data(
     ReportData {
         title: study.path.file_name().map_or_else(|| study.path.display().to_string(), |n| n.to_string_lossy().into()),
         study_path: study.path.display().to_string(),
-        model: model_summary(study, model),
+        model: model_summary(study, model, &excitation.pattern),
         sweep: SweepSummary {
             load: excitation.load.clone(),
             levels_n: excitation.levels_n.clone(),
@@ -876,7 +876,7 @@ pub fn report_data(
 }
 
 /// The model of a study in words, with the natural frequencies of its linear part.
-fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
+fn model_summary(study: &Study, model: &NonlinearModel, pattern: &[f64]) -> ModelSummary {
     let file =
         |p: &std::path::Path| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into());
     let source = match &study.model {
@@ -968,6 +968,7 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
         })
         .collect();
     let n = model.linear.n_dofs();
+    let mut load_participation = Vec::new();
     let natural_frequencies = if n > REPORT_MAX_EIGEN_DOFS {
         NaturalFrequencies::NotAvailable(format!(
             "the model has {n} DOFs, more than the {REPORT_MAX_EIGEN_DOFS} of the dense eigensolution (see `stickslip modes`)"
@@ -975,10 +976,20 @@ fn model_summary(study: &Study, model: &NonlinearModel) -> ModelSummary {
     } else {
         match model.linear.dense_modes() {
             Ok(modes) => {
+                // Which modes the load drives: (φ_rᵀF)² of the mass-normalised modes, over their
+                // sum over every mode (FᵀM⁻¹F: the dense solution has them all).
+                let shapes = &modes.shapes;
+                let driven: Vec<f64> = (0..shapes.ncols())
+                    .map(|r| pattern.iter().enumerate().map(|(i, p)| shapes[(i, r)] * p).sum::<f64>().powi(2))
+                    .collect();
+                let total: f64 = driven.iter().sum();
+                if total > 0.0 {
+                    load_participation = driven.iter().take(REPORT_FREQUENCIES).map(|d| d / total).collect();
+                }
                 NaturalFrequencies::Computed(modes.frequencies_hz().into_iter().take(REPORT_FREQUENCIES).collect())
             }
             Err(e) => NaturalFrequencies::NotAvailable(format!("the eigensolution failed: {e}")),
         }
     };
-    ModelSummary { source, n_dofs: n, reduction, damping, joints, natural_frequencies }
+    ModelSummary { source, n_dofs: n, reduction, damping, joints, natural_frequencies, load_participation }
 }

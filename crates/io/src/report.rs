@@ -68,6 +68,10 @@ pub struct ModelSummary {
     pub joints: Vec<JointSummary>,
     /// Lowest natural frequencies of the analysed linear model `(K, M)`.
     pub natural_frequencies: NaturalFrequencies,
+    /// Per mode of `natural_frequencies`, the share of the excitation that drives it:
+    /// `(φ_rᵀF)² / FᵀM⁻¹F` with mass-normalised modes (the shares of all modes sum to 1; the
+    /// modes a shaker test sees); empty when not computed.
+    pub load_participation: Vec<f64>,
 }
 
 /// A joint: its name, where it acts, its law and the law's parameters (with units).
@@ -467,16 +471,25 @@ fn model_section(h: &mut String, data: &ReportData) {
     match &m.natural_frequencies {
         NaturalFrequencies::Computed(f) if !f.is_empty() => {
             h.push_str("<p>Lowest modes of the linear model analysed (M, K without the joints' nonlinear forces: joints in the paper's form count as stuck).</p>\n");
-            h.push_str("<table>\n<tr><th>mode</th><th>frequency (Hz)</th><th>in the band</th></tr>\n");
+            let driven = m.load_participation.len() == f.len();
+            h.push_str("<table>\n<tr><th>mode</th><th>frequency (Hz)</th><th>in the band</th>");
+            if driven {
+                h.push_str("<th>driven by the load (share of (φ<sup>T</sup>F)²)</th>");
+            }
+            h.push_str("</tr>\n");
             let (lo, hi) = (data.sweep.start_hz.min(data.sweep.end_hz), data.sweep.start_hz.max(data.sweep.end_hz));
             for (r, f) in f.iter().enumerate() {
                 let inside = if (lo..=hi).contains(f) { "yes" } else { "" };
-                let _ = writeln!(
+                let _ = write!(
                     h,
-                    "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{inside}</td></tr>",
+                    "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{inside}</td>",
                     r + 1,
                     fixed(*f, 3)
                 );
+                if driven {
+                    let _ = write!(h, "<td class=\"num\">{}</td>", sig(m.load_participation[r]));
+                }
+                h.push_str("</tr>\n");
             }
             h.push_str("</table>\n");
         }
@@ -777,6 +790,7 @@ mod tests {
                     parameters: "threshold 1000 N".into(),
                 }],
                 natural_frequencies: NaturalFrequencies::Computed(vec![238.2052, 1234.5]),
+                load_participation: vec![0.75, 0.25],
             },
             sweep: SweepSummary {
                 load: "shaker".into(),
@@ -886,6 +900,8 @@ mod tests {
         }
         // Natural frequencies, the level table, timings.
         assert!(html.contains("238.205") && html.contains("1234.500"));
+        // The share of the load each mode takes, beside its frequency.
+        assert!(html.contains("<td class=\"num\">238.205</td><td>yes</td><td class=\"num\">0.7500</td>"), "{html}");
         assert!(html.contains("<td class=\"num\">1000</td><td class=\"num\">0</td><td class=\"bad\">"));
         assert!(html.contains("1.235"));
         assert!(html.contains("No figures."));
