@@ -653,6 +653,18 @@ pub struct ComparedPeak {
     pub simulated_amplitude: f64,
 }
 
+impl ComparedPeak {
+    /// Simulated − measured frequency, relative to measured (%).
+    pub fn frequency_error_pct(&self) -> f64 {
+        100.0 * (self.simulated_frequency_hz - self.measured_frequency_hz) / self.measured_frequency_hz
+    }
+
+    /// Simulated − measured amplitude, relative to measured (%).
+    pub fn amplitude_error_pct(&self) -> f64 {
+        100.0 * (self.simulated_amplitude - self.measured_amplitude) / self.measured_amplitude
+    }
+}
+
 const COMPARISON_BEGIN: &str = "<!-- test comparison -->\n";
 const COMPARISON_END: &str = "<!-- end of test comparison -->\n";
 
@@ -671,8 +683,6 @@ pub fn with_comparison(page: &str, comparison: &Comparison) -> Result<String, Re
     );
     section.push_str("<table>\n<tr><th>level (N)</th><th>output</th><th>unit</th><th>measured</th><th>f measured (Hz)</th><th>f simulated (Hz)</th><th>Δf (%)</th><th>peak measured</th><th>peak simulated</th><th>error (%)</th></tr>\n");
     for p in &comparison.peaks {
-        let df = 100.0 * (p.simulated_frequency_hz - p.measured_frequency_hz) / p.measured_frequency_hz;
-        let da = 100.0 * (p.simulated_amplitude - p.measured_amplitude) / p.measured_amplitude;
         let _ = writeln!(
             section,
             "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
@@ -682,10 +692,10 @@ pub fn with_comparison(page: &str, comparison: &Comparison) -> Result<String, Re
             escape(&p.source),
             fixed(p.measured_frequency_hz, 3),
             fixed(p.simulated_frequency_hz, 3),
-            fixed(df, 2),
+            fixed(p.frequency_error_pct(), 2),
             sig(p.measured_amplitude),
             sig(p.simulated_amplitude),
-            fixed(da, 2),
+            fixed(p.amplitude_error_pct(), 2),
         );
     }
     section.push_str("</table>\n");

@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use stickslip_core::signal::peaks::{peaks, Peak};
+use stickslip_core::signal::peaks::peaks;
 use stickslip_io::plot::{self, MeasuredCurve};
 use stickslip_io::records::{self, FrfCurve, FrfSet};
 use stickslip_io::report;
@@ -109,17 +109,6 @@ struct Group {
     quantity: &'static str,
     simulated: (Vec<f64>, Vec<f64>),
     measured: Vec<MeasuredCurve>,
-}
-
-/// One compared peak.
-struct PeakRow {
-    level_n: f64,
-    output: String,
-    unit: String,
-    /// Measured file (stem).
-    source: String,
-    measured: Peak,
-    simulated: Option<Peak>,
 }
 
 pub fn main(args: Args) -> Result<()> {
@@ -215,13 +204,15 @@ pub fn main(args: Args) -> Result<()> {
                             (a.frequency_hz - m.frequency_hz).abs().total_cmp(&(b.frequency_hz - m.frequency_hz).abs())
                         })
                         .copied();
-                    rows.push(PeakRow {
+                    rows.push(report::ComparedPeak {
                         level_n: sim_l,
                         output: output.clone(),
                         unit: curve.unit.clone(),
                         source: stem.clone(),
-                        measured: m,
-                        simulated: nearest,
+                        measured_frequency_hz: m.frequency_hz,
+                        measured_amplitude: m.amplitude,
+                        simulated_frequency_hz: nearest.map_or(f64::NAN, |p| p.frequency_hz),
+                        simulated_amplitude: nearest.map_or(f64::NAN, |p| p.amplitude),
                     });
                 }
                 let same = |g: &Group| g.level_index == level_index && g.output == output && g.quantity == quantity;
@@ -292,19 +283,7 @@ pub fn main(args: Args) -> Result<()> {
         let comparison = report::Comparison {
             measured: args.measured.iter().map(|m| m.display().to_string()).collect(),
             figures,
-            peaks: rows
-                .iter()
-                .map(|r| report::ComparedPeak {
-                    level_n: r.level_n,
-                    output: r.output.clone(),
-                    unit: r.unit.clone(),
-                    source: r.source.clone(),
-                    measured_frequency_hz: r.measured.frequency_hz,
-                    measured_amplitude: r.measured.amplitude,
-                    simulated_frequency_hz: r.simulated.map_or(f64::NAN, |p| p.frequency_hz),
-                    simulated_amplitude: r.simulated.map_or(f64::NAN, |p| p.amplitude),
-                })
-                .collect(),
+            peaks: rows,
         };
         let page = std::fs::read_to_string(&report).with_context(|| format!("reading {}", report.display()))?;
         let page = report::with_comparison(&page, &comparison)?;
@@ -315,7 +294,7 @@ pub fn main(args: Args) -> Result<()> {
 }
 
 /// Text table and CSV of the compared peaks; errors are simulated − measured, relative to measured.
-fn peak_table(rows: &[PeakRow]) -> (String, String) {
+fn peak_table(rows: &[report::ComparedPeak]) -> (String, String) {
     let mut text = format!(
         "{:>10} {:<14} {:<16} {:>12} {:>12} {:>9} {:>12} {:>12} {:>9}\n",
         "level_N", "output", "measured", "f_meas_Hz", "f_sim_Hz", "df_%", "amp_meas", "amp_sim", "amp_err_%"
@@ -324,20 +303,28 @@ fn peak_table(rows: &[PeakRow]) -> (String, String) {
         "level_N,output,unit,measured_file,measured_frequency_Hz,simulated_frequency_Hz,frequency_error_Hz,frequency_error_pct,measured_amplitude,simulated_amplitude,amplitude_error_pct\n",
     );
     for r in rows {
-        let m = r.measured;
-        let (sf, sa) = r.simulated.map_or((f64::NAN, f64::NAN), |s| (s.frequency_hz, s.amplitude));
-        let df = sf - m.frequency_hz;
-        let df_pct = 100.0 * df / m.frequency_hz;
-        let da_pct = 100.0 * (sa - m.amplitude) / m.amplitude;
+        let (mf, sf, ma, sa) =
+            (r.measured_frequency_hz, r.simulated_frequency_hz, r.measured_amplitude, r.simulated_amplitude);
+        let (df_pct, da_pct) = (r.frequency_error_pct(), r.amplitude_error_pct());
         let _ = writeln!(
             text,
             "{:>10.1} {:<14} {:<16} {:>12.3} {:>12.3} {:>9.2} {:>12.4e} {:>12.4e} {:>9.2}",
-            r.level_n, r.output, r.source, m.frequency_hz, sf, df_pct, m.amplitude, sa, da_pct
+            r.level_n, r.output, r.source, mf, sf, df_pct, ma, sa, da_pct
         );
         let _ = writeln!(
             csv,
             "{},{},{},{},{},{},{},{},{},{},{}",
-            r.level_n, r.output, r.unit, r.source, m.frequency_hz, sf, df, df_pct, m.amplitude, sa, da_pct
+            r.level_n,
+            r.output,
+            r.unit,
+            r.source,
+            mf,
+            sf,
+            sf - mf,
+            df_pct,
+            ma,
+            sa,
+            da_pct
         );
     }
     (text, csv)

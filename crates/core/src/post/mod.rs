@@ -327,28 +327,23 @@ fn recovered_result(
                     .sum()
             })
             .collect();
-        // One series per direction, empty when skipped.
-        let per_direction = |samples: &[f64]| -> Vec<Vec<f64>> {
-            if kept {
-                samples.chunks(nt).map(<[f64]>::to_vec).collect()
-            } else {
-                vec![Vec::new(); d]
-            }
+        // The series per direction (one empty series per direction when skipped).
+        let (displacement, force, slider_velocity) = if kept {
+            // The velocity samples as the AFT computes them, Ω du/dθ (it skips them for the
+            // rate-independent laws, whose update never reads them).
+            let mut rate = vec![0.0; nt];
+            let slider_velocity = (0..d)
+                .map(|a| {
+                    let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
+                    plan.synthesize_derivative(&coeffs, &mut rate, &mut scratch);
+                    (0..nt).map(|j| if e.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
+                })
+                .collect();
+            let per_direction = |samples: &[f64]| samples.chunks(nt).map(<[f64]>::to_vec).collect::<Vec<_>>();
+            (per_direction(&e.displacement), per_direction(&e.force), slider_velocity)
+        } else {
+            (vec![Vec::new(); d], vec![Vec::new(); d], vec![Vec::new(); d])
         };
-        let (displacement, force) = (per_direction(&e.displacement), per_direction(&e.force));
-        // The velocity samples as the AFT computes them, Ω du/dθ (it skips them for the
-        // rate-independent laws, whose update never reads them).
-        let mut rate = vec![0.0; if kept { nt } else { 0 }];
-        let slider_velocity = (0..d)
-            .map(|a| {
-                if !kept {
-                    return Vec::new();
-                }
-                let coeffs: Vec<f64> = (0..nc).map(|c| x[c * q + offset + a]).collect();
-                plan.synthesize_derivative(&coeffs, &mut rate, &mut scratch);
-                (0..nt).map(|j| if e.slipping[j] { omega * rate[j] } else { 0.0 }).collect()
-            })
-            .collect();
         let stuck = e.slipping.iter().filter(|s| !**s).count();
         element_results.push(ElementResult {
             name: e.name.to_string(),

@@ -228,12 +228,7 @@ impl Study {
             .chain(self.joints.iter().map(|j| (&j.placement, format!("[[joint]] {:?}", j.name), j.at)))
             .chain(self.outputs.iter().map(|o| (&o.placement, format!("[[output]] {:?}", o.name), o.at)));
         for (placement, ctx, at) in placements {
-            let found = match placement {
-                Placement::Dof(a) => space.index(a, &ctx).map(drop),
-                Placement::Between(a, b) => space.index(a, &ctx).and_then(|_| space.index(b, &ctx)).map(drop),
-                Placement::Vector(_) => full_vector(&space, placement, &ctx).map(drop),
-            };
-            found.map_err(|kind| self.error(Some(at), kind))?;
+            full_vector(&space, placement, &ctx).map_err(|kind| self.error(Some(at), kind))?;
         }
         Ok(())
     }
