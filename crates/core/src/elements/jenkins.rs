@@ -83,15 +83,24 @@ impl Element for Jenkins {
     /// `w = u_max − F_c/k`, whatever happened before.
     fn periodic_start(&self, u: &[f64], n_t: usize, state: &mut [f64], dstate_du: &mut [f64]) -> Option<usize> {
         let u = &u[..n_t];
-        // The largest value kept in a register rather than read back at j_max: the same first
-        // maximum, without a load on the loop's dependency chain.
-        let (mut j_max, mut u_max, mut u_min) = (0, u[0], u[0]);
-        for (j, &x) in u.iter().enumerate() {
-            if x > u_max {
-                (j_max, u_max) = (j, x);
-            }
-            u_min = u_min.min(x);
+        // Extremes over four interleaved lanes (independent chains the compiler vectorises),
+        // then the first sample at the maximum: the same first maximum as one strict `>` scan
+        // (a NaN never replaces a number, and a NaN start stays, at sample 0).
+        let (mut max4, mut min4) = ([u[0]; 4], [u[0]; 4]);
+        let chunks = u.chunks_exact(4);
+        for x in chunks.remainder() {
+            max4[0] = if *x > max4[0] { *x } else { max4[0] };
+            min4[0] = min4[0].min(*x);
         }
+        for x in chunks {
+            for l in 0..4 {
+                max4[l] = if x[l] > max4[l] { x[l] } else { max4[l] };
+                min4[l] = min4[l].min(x[l]);
+            }
+        }
+        let u_max = max4.into_iter().fold(u[0], |m, x| if x > m { x } else { m });
+        let u_min = min4.into_iter().fold(u[0], f64::min);
+        let j_max = u.iter().position(|&x| x == u_max).unwrap_or(0);
         if self.stiffness * (u_max - u_min) <= 2.0 * self.threshold {
             return None;
         }
@@ -102,6 +111,38 @@ impl Element for Jenkins {
 
     fn slider_stiffness(&self) -> Option<f64> {
         Some(self.stiffness)
+    }
+
+    /// The return mapping of [`Element::update`] marched over a stretch, bit for bit the same
+    /// steps: a slip moves the slider to `u − sgn(f_tr) F_c/k`, and `(±F_c)/k = ±(F_c/k)`
+    /// exactly, so the division is made once instead of on the loop's dependency chain (the
+    /// AFT marches every sample of every slider at every Newton iteration).
+    fn update_slider_samples(
+        &self,
+        u: &[f64],
+        _v: &[f64],
+        range: std::ops::Range<usize>,
+        state: &mut f64,
+        g: &mut [f64],
+        slipping: &mut [bool],
+    ) {
+        let (k, fc) = (self.stiffness, self.threshold);
+        let slip_offset = fc / k;
+        let linear = if self.replaces_stiffness { k } else { 0.0 };
+        let mut w = *state;
+        for j in range {
+            let before = w;
+            let trial = k * (u[j] - w);
+            let f = if trial.abs() < fc {
+                trial
+            } else {
+                w = u[j] - trial.signum() * slip_offset;
+                trial.signum() * fc
+            };
+            g[j] = f - linear * u[j];
+            slipping[j] = before != w;
+        }
+        *state = w;
     }
 
     fn update(&self, u: &[f64], _v: &[f64], state: &mut [f64], g: &mut [f64], tangent: Option<&mut Tangent>) {
@@ -124,6 +165,90 @@ impl Element for Jenkins {
             t.dg_ds[0] = -stick * k;
             t.ds_ds[0] = stick;
             t.ds_du[0] = slip;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Motions that stick and slip, with repeated extremes and samples exactly at the
+    /// threshold: a few harmonics of random-like amplitudes plus a plateau at the maximum.
+    fn motions() -> Vec<Vec<f64>> {
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let nt = 300;
+        let mut all = Vec::new();
+        for case in 0..200 {
+            let amps: Vec<f64> = (0..5).map(|_| next() * 1e-4).collect();
+            let phases: Vec<f64> = (0..5).map(|_| next() * 6.0).collect();
+            let mut u: Vec<f64> = (0..nt)
+                .map(|j| {
+                    let th = 2.0 * std::f64::consts::PI * j as f64 / nt as f64;
+                    (0..5).map(|h| amps[h] * ((h + 1) as f64 * th + phases[h]).cos()).sum()
+                })
+                .collect();
+            if case % 4 == 0 {
+                let top = u.iter().cloned().fold(f64::MIN, f64::max);
+                let at = u.iter().position(|&x| x == top).unwrap();
+                for x in u.iter_mut().skip(at).take(3) {
+                    *x = top;
+                }
+            }
+            all.push(u);
+        }
+        all
+    }
+
+    /// The marched stretch must be the sample-by-sample return mapping bit for bit (the AFT's
+    /// results must not depend on which path a law takes).
+    #[test]
+    fn the_marched_stretch_is_the_return_mapping_bit_for_bit() {
+        for law in [Jenkins::new(8.11e6, 300.0).unwrap(), Jenkins::replacing_stiffness(2.0e7, 150.0).unwrap()] {
+            for u in motions() {
+                let nt = u.len();
+                let v = vec![0.0; nt];
+                let (mut g_fast, mut slip_fast) = (vec![0.0; nt], vec![false; nt]);
+                let mut w_fast = 1e-6;
+                law.update_slider_samples(&u, &v, 0..nt, &mut w_fast, &mut g_fast, &mut slip_fast);
+                let mut w = [1e-6];
+                for j in 0..nt {
+                    let before = w;
+                    let mut g = [0.0];
+                    law.update(&u[j..j + 1], &v[j..j + 1], &mut w, &mut g, None);
+                    assert_eq!(g[0].to_bits(), g_fast[j].to_bits(), "force at sample {j}");
+                    assert_eq!(law.is_slipping(&before, &w), slip_fast[j], "slip flag at sample {j}");
+                }
+                assert_eq!(w[0].to_bits(), w_fast.to_bits());
+            }
+        }
+    }
+
+    /// The periodic start is at the first sample of the largest displacement, as a strict `>`
+    /// scan finds it, with the slider just slipped forward.
+    #[test]
+    fn the_periodic_start_is_at_the_first_maximum() {
+        let law = Jenkins::new(8.11e6, 30.0).unwrap();
+        for u in motions() {
+            let (mut j_max, mut u_max, mut u_min) = (0, u[0], u[0]);
+            for (j, &x) in u.iter().enumerate() {
+                if x > u_max {
+                    (j_max, u_max) = (j, x);
+                }
+                u_min = u_min.min(x);
+            }
+            let (mut state, mut ds) = ([0.0], [0.0]);
+            let start = law.periodic_start(&u, u.len(), &mut state, &mut ds);
+            if 8.11e6 * (u_max - u_min) <= 60.0 {
+                assert_eq!(start, None);
+            } else {
+                assert_eq!(start, Some(j_max));
+                assert_eq!(state[0].to_bits(), (u_max - 30.0 / 8.11e6).to_bits());
+            }
         }
     }
 }

@@ -246,15 +246,17 @@ impl ElementAft {
                     }
                 }
                 self.state[0] = w;
-                {
-                    for i in 0..nt {
-                        let j = wrap(j0 + i, nt);
-                        if self.slipping[j] {
-                            anchor = Some(j);
-                        }
-                        self.anchor[j] = anchor.unwrap_or(usize::MAX);
+                // In marching order, the two stretches without a wrap per sample.
+                let mut last_slip = anchor.unwrap_or(usize::MAX);
+                for range in [j0..nt, 0..j0] {
+                    let first = range.start;
+                    let slips = self.slipping[range.clone()].iter().zip(&mut self.anchor[range]);
+                    for (i, (&slipping, a)) in slips.enumerate() {
+                        last_slip = if slipping { first + i } else { last_slip };
+                        *a = last_slip;
                     }
                 }
+                anchor = (last_slip != usize::MAX).then_some(last_slip);
             } else {
                 for i in 0..nt {
                     let j = (j0 + i) % nt;
@@ -368,13 +370,13 @@ impl ElementAft {
         // Σ_j w_j basis_c basis_c' from products of cos/sin (harmonics a of c, b of c').
         let wc = |m: isize| self.weight_cos[m.unsigned_abs()];
         let ws = |m: isize| m.signum() as f64 * self.weight_sin[m.unsigned_abs()];
-        for c in 0..nc {
-            let scale = if c == 0 { 1.0 } else { 2.0 } / nt as f64;
-            let a = c.div_ceil(2) as isize;
-            let a_cos = c == 0 || c % 2 == 1;
-            for c2 in 0..nc {
-                let b = c2.div_ceil(2) as isize;
-                let b_cos = c2 == 0 || c2 % 2 == 1;
+        for c2 in 0..nc {
+            let b = c2.div_ceil(2) as isize;
+            let b_cos = c2 == 0 || c2 % 2 == 1;
+            for c in 0..nc {
+                let scale = if c == 0 { 1.0 } else { 2.0 } / nt as f64;
+                let a = c.div_ceil(2) as isize;
+                let a_cos = c == 0 || c % 2 == 1;
                 let sum = match (a_cos, b_cos) {
                     (true, true) => 0.5 * (wc(a - b) + wc(a + b)),
                     (false, false) => 0.5 * (wc(a - b) - wc(a + b)),
@@ -384,29 +386,26 @@ impl ElementAft {
                 jac[(c, c2)] = scale * sum;
             }
         }
-        // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order.
+        // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order, each
+        // segment's sum from the plan's running sums.
         let mut current = usize::MAX;
-        self.coeff_buf.iter_mut().for_each(|v| *v = 0.0);
+        let mut start = 0;
         for i in 0..=nt {
             let j = wrap(j0 + i, nt);
             let a = if i == nt || self.slipping[j] { usize::MAX } else { self.anchor[j] };
             if a != current {
                 if current != usize::MAX {
+                    plan.projection_sum(wrap(j0 + start, nt), i - start, &mut self.coeff_buf);
+                    self.coeff_buf.iter_mut().for_each(|v| *v *= k);
                     let e_a = plan.basis_at(current);
-                    for c in 0..nc {
-                        let pc = k * self.coeff_buf[c];
-                        for c2 in 0..nc {
-                            jac[(c, c2)] -= pc * e_a[c2];
+                    for (c2, &e) in e_a.iter().enumerate() {
+                        for (c, pc) in self.coeff_buf.iter().enumerate() {
+                            jac[(c, c2)] -= pc * e;
                         }
                     }
                 }
-                self.coeff_buf.iter_mut().for_each(|v| *v = 0.0);
                 current = a;
-            }
-            if current != usize::MAX {
-                for (b, pc) in self.coeff_buf.iter_mut().zip(plan.projection_at(j)) {
-                    *b += pc;
-                }
+                start = i;
             }
         }
     }

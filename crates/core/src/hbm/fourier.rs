@@ -66,6 +66,9 @@ pub struct AftPlan {
     /// `P[(c, j)]`: weight of sample j in coefficient c (`(2N+1) × n_t`), X = P x (exact for
     /// band-limited signals, the DFT projection otherwise). `P E = I`.
     projection: Mat<f64>,
+    /// Running sums of `P`'s columns (`(2N+1) × (n_t+1)`): column j is `Σ_{i<j} P[(·, i)]`,
+    /// so that a stretch of samples is summed by one difference ([`Self::projection_sum`]).
+    projection_prefix: Mat<f64>,
 }
 
 impl std::fmt::Debug for AftPlan {
@@ -103,6 +106,19 @@ impl AftPlan {
             let w = if c == 0 { 1.0 } else { 2.0 };
             w / n_samples as f64 * basis(c, j as f64 * dtheta)
         });
+        // Compensated (Neumaier) running sums: each column is the exact sum rounded once, so a
+        // stretch's sum (a difference of two) is within ~2 ulp of 1, not the error of n_t additions.
+        let mut projection_prefix = Mat::zeros(nc, n_samples + 1);
+        for c in 0..nc {
+            let (mut sum, mut compensation) = (0.0f64, 0.0f64);
+            for j in 0..n_samples {
+                let x = projection[(c, j)];
+                let t = sum + x;
+                compensation += if sum.abs() >= x.abs() { (sum - t) + x } else { (x - t) + sum };
+                sum = t;
+                projection_prefix[(c, j + 1)] = sum + compensation;
+            }
+        }
         let basis_at_sample = synthesis.transpose().to_owned();
         let basis_derivative_at_sample = synthesis_derivative.transpose().to_owned();
         Ok(AftPlan {
@@ -115,6 +131,7 @@ impl AftPlan {
             basis_at_sample,
             basis_derivative_at_sample,
             projection,
+            projection_prefix,
         })
     }
 
@@ -154,6 +171,26 @@ impl AftPlan {
     /// The weights of sample `j` in every coefficient: column j of `P`, contiguous.
     pub fn projection_at(&self, j: usize) -> &[f64] {
         self.projection.col_as_slice(j)
+    }
+
+    /// `Σ P[(·, j)]` over the `count ≤ n_t` samples from `first` on, wrapping past the period's
+    /// end, into `sum` (length `2N+1`): two or three columns of the running sums instead of
+    /// `count` columns (a stuck slider's Jacobian sums `P` over each stick phase). Equal to the
+    /// direct sum to round-off of the running sums' size (`|Σ P| ≤ 2`, so ~1e-16 absolute).
+    pub fn projection_sum(&self, first: usize, count: usize, sum: &mut [f64]) {
+        let nt = self.n_samples;
+        debug_assert!(first < nt && count <= nt);
+        let at = |j: usize| self.projection_prefix.col_as_slice(j);
+        let end = first + count;
+        if end <= nt {
+            for ((s, a), b) in sum.iter_mut().zip(at(end)).zip(at(first)) {
+                *s = a - b;
+            }
+        } else {
+            for (((s, a), b), c) in sum.iter_mut().zip(at(nt)).zip(at(first)).zip(at(end - nt)) {
+                *s = (a - b) + c;
+            }
+        }
     }
 
     /// Projection matrix `P` (`(2N+1) × n_t`): `X_c = Σ_j P[(c,j)] x_j`.
@@ -349,6 +386,34 @@ mod tests {
         }
         let (a, phi) = amplitude_phase(&c, 3);
         assert!((a - 5.0).abs() < 1e-15 && (phi + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    }
+
+    /// A stretch summed from the running sums equals the exact sum of its columns (a
+    /// compensated sum here), wrapping or not, within the rounding of two running sums of size
+    /// up to 1 and their difference: 4e-16 absolute.
+    #[test]
+    fn projection_sums_of_stretches_equal_the_direct_sums() {
+        let plan = AftPlan::new(7, 300).unwrap();
+        let nc = plan.n_coeffs();
+        let mut sum = vec![0.0; nc];
+        for (first, count) in [(0, 0), (0, 1), (0, 300), (17, 40), (250, 50), (250, 51), (299, 300), (123, 299)] {
+            plan.projection_sum(first, count, &mut sum);
+            for c in 0..nc {
+                let (mut direct, mut compensation) = (0.0f64, 0.0f64);
+                for i in 0..count {
+                    let x = plan.projection()[(c, (first + i) % 300)];
+                    let t = direct + x;
+                    compensation += if direct.abs() >= x.abs() { (direct - t) + x } else { (x - t) + direct };
+                    direct = t;
+                }
+                let direct = direct + compensation;
+                assert!(
+                    (sum[c] - direct).abs() <= 4e-16,
+                    "({first}, {count}) coefficient {c}: {} against {direct}",
+                    sum[c]
+                );
+            }
+        }
     }
 
     #[test]
