@@ -399,7 +399,7 @@ impl<'m> CondensedHbm<'m> {
         for i in 0..q * nc {
             dx[(i, i)] = 1.0;
         }
-        let (h0, harmonic) = (&self.h0, &self.harmonic);
+        let (h0, harmonic, sums) = (&self.h0, &self.harmonic, &mut self.product);
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
@@ -407,32 +407,38 @@ impl<'m> CondensedHbm<'m> {
             for c2 in 0..nc {
                 for b in 0..d {
                     // One column of ∂R/∂x and of the element's block, as contiguous slices
-                    // (this runs at every Newton iteration).
+                    // (this runs at every Newton iteration); the sums over the element's
+                    // directions `a` in `sums` (cosine part in re, sine part in im), a column of
+                    // H at a time.
                     let col = c2 * q + off + b;
                     let jcol = je.col_as_slice(c2 * d + b);
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    for (i, out) in column[..q].iter_mut().enumerate() {
-                        let mut v = 0.0;
-                        for a in 0..d {
-                            v += h0.col_as_slice(off + a)[i] * jcol[a];
+                    sums.fill(c64::new(0.0, 0.0));
+                    for a in 0..d {
+                        let g = jcol[a];
+                        for (v, h) in sums.iter_mut().zip(h0.col_as_slice(off + a)) {
+                            v.re += h * g;
                         }
-                        *out += v;
+                    }
+                    for (out, v) in column[..q].iter_mut().zip(sums.iter()) {
+                        *out += v.re;
                     }
                     for k in 1..=self.plan.n_harmonics() {
                         let h = &harmonic[k - 1].h;
                         let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                         let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
-                        for i in 0..q {
-                            let mut vc = 0.0;
-                            let mut vs = 0.0;
-                            for a in 0..d {
-                                let h = h.col_as_slice(off + a)[i];
-                                let (gc, gs) = (jcol[ec + a], jcol[es + a]);
-                                vc += h.re * gc + h.im * gs;
-                                vs += -h.im * gc + h.re * gs;
+                        sums.fill(c64::new(0.0, 0.0));
+                        for a in 0..d {
+                            let (gc, gs) = (jcol[ec + a], jcol[es + a]);
+                            for (v, h) in sums.iter_mut().zip(h.col_as_slice(off + a)) {
+                                v.re += h.re * gc + h.im * gs;
+                                v.im += -h.im * gc + h.re * gs;
                             }
-                            column[ic + i] += vc;
-                            column[is + i] += vs;
+                        }
+                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
+                        for ((oc, os), v) in cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(sums.iter()) {
+                            *oc += v.re;
+                            *os += v.im;
                         }
                     }
                 }

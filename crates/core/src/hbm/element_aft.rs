@@ -373,7 +373,8 @@ impl ElementAft {
         for c2 in 0..nc {
             let b = c2.div_ceil(2) as isize;
             let b_cos = c2 == 0 || c2 % 2 == 1;
-            for c in 0..nc {
+            let column = jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
+            for (c, entry) in column.iter_mut().enumerate() {
                 let scale = if c == 0 { 1.0 } else { 2.0 } / nt as f64;
                 let a = c.div_ceil(2) as isize;
                 let a_cos = c == 0 || c % 2 == 1;
@@ -383,7 +384,7 @@ impl ElementAft {
                     (true, false) => 0.5 * (ws(a + b) - ws(a - b)),
                     (false, true) => 0.5 * (ws(a + b) + ws(a - b)),
                 };
-                jac[(c, c2)] = scale * sum;
+                *entry = scale * sum;
             }
         }
         // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order, each
@@ -399,8 +400,10 @@ impl ElementAft {
                     self.coeff_buf.iter_mut().for_each(|v| *v *= k);
                     let e_a = plan.basis_at(current);
                     for (c2, &e) in e_a.iter().enumerate() {
-                        for (c, pc) in self.coeff_buf.iter().enumerate() {
-                            jac[(c, c2)] -= pc * e;
+                        let column =
+                            jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
+                        for (entry, pc) in column.iter_mut().zip(&self.coeff_buf) {
+                            *entry -= pc * e;
                         }
                     }
                 }
