@@ -100,6 +100,9 @@ pub struct ElementAft {
     /// Fourier sums of the stick weights, cos and sin, harmonics 0..=2N.
     weight_cos: Vec<f64>,
     weight_sin: Vec<f64>,
+    /// A slider's stick phases (first sample, samples, anchor), for its Jacobian; room for
+    /// every phase a period can hold, so that it never grows.
+    stick_phases: Vec<(usize, usize, usize)>,
     tangent: Tangent,
     /// `S` before and after an update, row-major `s × (nc·d + 1)`.
     sens: Vec<f64>,
@@ -144,6 +147,7 @@ impl ElementAft {
             last_slider: None,
             weight_cos: vec![0.0; 2 * (nc / 2) + 1],
             weight_sin: vec![0.0; 2 * (nc / 2) + 1],
+            stick_phases: Vec::with_capacity(nt + 1),
             tangent: Tangent::new(d, s),
             sens: vec![0.0; s * cols],
             sens_next: vec![0.0; s * cols],
@@ -362,11 +366,40 @@ impl ElementAft {
     /// sample.
     fn slider_jacobian(&mut self, plan: &AftPlan, k: f64, k_r: f64, j0: usize, mut jac: MatMut<'_, f64>) {
         let (nc, nt) = (self.nc, self.nt);
-        // Fourier sums of w_j = k s_j − k_r up to harmonic 2N (one planned FFT).
-        for j in 0..nt {
-            self.time_buf[j] = if self.slipping[j] { -k_r } else { k - k_r };
+        // The stick phases in marching order (first sample, samples, anchor): the samples
+        // stuck to one anchor, or at rest with none (`NO_ANCHOR`: stuck since the march began,
+        // the stuck-mean convention: a weight, no memory term).
+        const SLIPPING: usize = usize::MAX;
+        const NO_ANCHOR: usize = usize::MAX - 1;
+        self.stick_phases.clear();
+        let mut current = SLIPPING;
+        let mut start = 0;
+        for i in 0..=nt {
+            let j = wrap(j0 + i, nt);
+            let a = if i == nt || self.slipping[j] {
+                SLIPPING
+            } else if self.anchor[j] == usize::MAX {
+                NO_ANCHOR
+            } else {
+                self.anchor[j]
+            };
+            if a != current {
+                if current != SLIPPING {
+                    self.stick_phases.push((wrap(j0 + start, nt), i - start, current));
+                }
+                current = a;
+                start = i;
+            }
         }
-        plan.fourier_sums(&self.time_buf, &mut self.weight_cos, &mut self.weight_sin, &mut self.scratch);
+        // Fourier sums of w_j = k s_j − k_r up to harmonic 2N: k times the stick phases' sums,
+        // less k_r Σ_j cos mθ_j = k_r n_t δ_m0 (Σ_j sin mθ_j = 0; m ≤ 2N < n_t).
+        self.weight_cos.fill(0.0);
+        self.weight_sin.fill(0.0);
+        for &(first, count, _) in &self.stick_phases {
+            plan.add_fourier_sums(first, count, &mut self.weight_cos, &mut self.weight_sin);
+        }
+        self.weight_cos.iter_mut().chain(self.weight_sin.iter_mut()).for_each(|v| *v *= k);
+        self.weight_cos[0] -= k_r * nt as f64;
         // Σ_j w_j basis_c basis_c' from products of cos/sin (harmonics a of c, b of c').
         let wc = |m: isize| self.weight_cos[m.unsigned_abs()];
         let ws = |m: isize| m.signum() as f64 * self.weight_sin[m.unsigned_abs()];
@@ -387,28 +420,16 @@ impl ElementAft {
                 *entry = scale * sum;
             }
         }
-        // −k Σ_segments (Σ_{j ∈ segment, stuck} P_j) E_aᵀ, segments in marching order, each
-        // segment's sum from the plan's running sums.
-        let mut current = usize::MAX;
-        let mut start = 0;
-        for i in 0..=nt {
-            let j = wrap(j0 + i, nt);
-            let a = if i == nt || self.slipping[j] { usize::MAX } else { self.anchor[j] };
-            if a != current {
-                if current != usize::MAX {
-                    plan.projection_sum(wrap(j0 + start, nt), i - start, &mut self.coeff_buf);
-                    self.coeff_buf.iter_mut().for_each(|v| *v *= k);
-                    let e_a = plan.basis_at(current);
-                    for (c2, &e) in e_a.iter().enumerate() {
-                        let column =
-                            jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                        for (entry, pc) in column.iter_mut().zip(&self.coeff_buf) {
-                            *entry -= pc * e;
-                        }
-                    }
+        // −k Σ_phases (Σ_{j ∈ phase} P_j) E_aᵀ, each phase's sum from the plan's running sums.
+        for &(first, count, anchor) in self.stick_phases.iter().filter(|p| p.2 != NO_ANCHOR) {
+            plan.projection_sum(first, count, &mut self.coeff_buf);
+            self.coeff_buf.iter_mut().for_each(|v| *v *= k);
+            let e_a = plan.basis_at(anchor);
+            for (c2, &e) in e_a.iter().enumerate() {
+                let column = jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
+                for (entry, pc) in column.iter_mut().zip(&self.coeff_buf) {
+                    *entry -= pc * e;
                 }
-                current = a;
-                start = i;
             }
         }
     }
@@ -764,6 +785,43 @@ mod tests {
                 }
             }
             assert_eq!(a1.slipping, a2.slipping);
+        }
+    }
+
+    /// A slider that never slips (stuck at rest since the march began: no anchor) and one that
+    /// slips from rest within the first period: the closed form's weights count every stuck
+    /// sample, anchored or not, as the chain rule over the march does (standalone: `k I` when
+    /// stuck throughout; paper form: zero).
+    #[test]
+    fn closed_form_slider_stuck_at_rest_equals_the_chain_rule_over_the_march() {
+        let plan = AftPlan::new(5, 256).unwrap();
+        let n = plan.n_coeffs();
+        for law in [Jenkins::new(1e6, 100.0).unwrap(), Jenkins::replacing_stiffness(1e6, 100.0).unwrap()] {
+            // 1e-5: stuck throughout; 9e-5: k u reaches F_c on one side only, so no periodic
+            // start is known and the march begins at rest.
+            for amplitude in [1e-5, 9e-5] {
+                let marched = Marched(law.clone());
+                let u = motion(amplitude);
+                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
+                let (mut j1, mut j2) = (Mat::zeros(n, n), Mat::zeros(n, n));
+                let (mut w1, mut w2) = (vec![0.0; n], vec![0.0; n]);
+                let mut a1 = ElementAft::new(&law, &plan);
+                let mut a2 = ElementAft::new(&marched, &plan);
+                a1.evaluate(&law, &plan, 500.0, &u, &mut g1, Some((j1.as_mut(), &mut w1))).unwrap();
+                a2.evaluate(&marched, &plan, 500.0, &u, &mut g2, Some((j2.as_mut(), &mut w2))).unwrap();
+                assert_eq!(a1.slipping, a2.slipping);
+                for i in 0..n {
+                    for j in 0..n {
+                        assert!((j1[(i, j)] - j2[(i, j)]).abs() < 1e-9 * 1e6, "{amplitude}: J[{i},{j}]");
+                    }
+                }
+                if amplitude == 1e-5 {
+                    let stuck = if law.replaces_stiffness() { 0.0 } else { 1e6 };
+                    for i in 0..n {
+                        assert!((j1[(i, i)] - stuck).abs() < 1e-9 * 1e6, "stuck diagonal {}", j1[(i, i)]);
+                    }
+                }
+            }
         }
     }
 
