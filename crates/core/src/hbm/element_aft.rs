@@ -400,24 +400,29 @@ impl ElementAft {
         }
         self.weight_cos.iter_mut().chain(self.weight_sin.iter_mut()).for_each(|v| *v *= k);
         self.weight_cos[0] -= k_r * nt as f64;
-        // Σ_j w_j basis_c basis_c' from products of cos/sin (harmonics a of c, b of c').
+        // Σ_j w_j basis_c basis_c' from products of cos/sin (harmonics a of c, b of c'), a
+        // 2 x 2 block (cos, sin of a) x (cos, sin of b) at a time from four sums.
         let wc = |m: isize| self.weight_cos[m.unsigned_abs()];
         let ws = |m: isize| m.signum() as f64 * self.weight_sin[m.unsigned_abs()];
-        for c2 in 0..nc {
-            let b = c2.div_ceil(2) as isize;
-            let b_cos = c2 == 0 || c2 % 2 == 1;
-            let column = jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
-            for (c, entry) in column.iter_mut().enumerate() {
-                let scale = if c == 0 { 1.0 } else { 2.0 } / nt as f64;
-                let a = c.div_ceil(2) as isize;
-                let a_cos = c == 0 || c % 2 == 1;
-                let sum = match (a_cos, b_cos) {
-                    (true, true) => 0.5 * (wc(a - b) + wc(a + b)),
-                    (false, false) => 0.5 * (wc(a - b) - wc(a + b)),
-                    (true, false) => 0.5 * (ws(a + b) - ws(a - b)),
-                    (false, true) => 0.5 * (ws(a + b) + ws(a - b)),
-                };
-                *entry = scale * sum;
+        let n = nc / 2;
+        let scale = |c: usize| if c == 0 { 1.0 } else { 2.0 } / nt as f64;
+        for b in 0..=n {
+            // The columns of harmonic b: cos (c' = 2b − 1, or 0) and sin (c' = 2b).
+            let (cos_col, sin_col) = if b == 0 { (0, None) } else { (2 * b - 1, Some(2 * b)) };
+            for a in 0..=n {
+                let (d, s) = ((a as isize) - (b as isize), (a + b) as isize);
+                let (cos_row, sin_row) = if a == 0 { (0, None) } else { (2 * a - 1, Some(2 * a)) };
+                let (wc_d, wc_s, ws_d, ws_s) = (wc(d), wc(s), ws(d), ws(s));
+                jac[(cos_row, cos_col)] = scale(cos_row) * (0.5 * (wc_d + wc_s));
+                if let Some(sin_row) = sin_row {
+                    jac[(sin_row, cos_col)] = scale(sin_row) * (0.5 * (ws_s + ws_d));
+                }
+                if let Some(sin_col) = sin_col {
+                    jac[(cos_row, sin_col)] = scale(cos_row) * (0.5 * (ws_s - ws_d));
+                    if let Some(sin_row) = sin_row {
+                        jac[(sin_row, sin_col)] = scale(sin_row) * (0.5 * (wc_d - wc_s));
+                    }
+                }
             }
         }
         // −k Σ_phases (Σ_{j ∈ phase} P_j) E_aᵀ, each phase's sum from the plan's running sums.
