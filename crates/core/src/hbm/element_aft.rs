@@ -35,8 +35,9 @@
 //!
 //! The first term is a Gram matrix of the harmonics weighted by `w = k s − k_r`, whose entries
 //! are the Fourier sums of `w` up to harmonic 2N (cos a·cos b = ½[cos(a−b) + cos(a+b)], ...);
-//! the second is one rank-one term per stick segment (two per period). O(n_t N + N²) instead of
-//! O(n_t N²).
+//! the second is one rank-one term per stick segment (two per period). Both sums over a
+//! segment's samples are differences of the plan's running sums ([`AftPlan::add_fourier_sums`],
+//! [`AftPlan::projection_sum`]): O(n_t + segments·N + N²) instead of O(n_t N²).
 
 use faer::linalg::matmul::matmul;
 use faer::{c64, Accum, Mat, MatMut, Par};
