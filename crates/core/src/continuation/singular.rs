@@ -186,7 +186,7 @@ pub struct SingularPoint {
 /// to `tolerance` on the chord between its two points. A fold: `τ_λ` changes sign (equivalently
 /// `det ∂R/∂x` does and `det B(τ)` does not); a branch point: `det B(τ)` changes sign. For a
 /// problem that factors its own Jacobian, which has no test functions, the folds alone, where
-/// λ turns back along the branch ([`turning_points`]).
+/// λ turns back along the branch (`turning_points`).
 ///
 /// [`Accepted::test_functions`]: super::Accepted::test_functions
 pub fn singular_points<P: Problem>(

@@ -265,7 +265,7 @@ pub fn folds_and_branch_points<P: Problem>(
 /// into two real exponents there): then the count of another kind changes too. Where only one
 /// kind's count changes, the crossing is reported, located or not; where several change in one
 /// step (a fold and a crossing close together, or a change of kind), only a located zero of the
-/// crossing exponent's real part (to [`CROSSED`] of Ω) is. Real exponents are left to
+/// crossing exponent's real part (to `CROSSED` of Ω) is. Real exponents are left to
 /// [`folds_and_branch_points`], which finds their crossings from the test functions (module
 /// documentation).
 ///

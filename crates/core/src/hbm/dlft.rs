@@ -576,7 +576,7 @@ impl DlftHbm {
 }
 
 /// Continuation in frequency of the DLFT balance at a fixed force level, for
-/// [`continue_branch`](crate::continuation::continue_branch) (`λ` is Ω, rad/s).
+/// [`crate::continuation::continue_branch`] (`λ` is Ω, rad/s).
 pub struct DlftFrequencySweep<'a> {
     pub dlft: &'a mut DlftHbm,
     pub level: f64,

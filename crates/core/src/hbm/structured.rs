@@ -37,7 +37,7 @@
 //! solves two right-hand sides per Newton iterate, Eq. 32: about 2 iterations each) and of
 //! the next Jacobians on the same coupled directions: from one Newton iterate or one point to
 //! the next `M` changes little (the slip and separation intervals move by a few samples), and
-//! about 7 iterations correct it. Where [`FACTORED_MAX`] iterations do not, `M` is factored
+//! about 7 iterations correct it. Where `FACTORED_MAX` iterations do not, `M` is factored
 //! afresh. On Harmony's blade patches (q = 156, N = 7, 2340 unknowns: a single-precision LU
 //! of 0.14 s, an iteration 4 ms) a Newton iterate costs 0.12 s instead of 0.6 s.
 //!

@@ -109,7 +109,7 @@ pub struct EigenSolution {
 }
 
 /// The `opts.count` modes of `(K, M)` nearest the shift (the lowest ones by default); see
-/// [`check_mass`] for what is refused on top of the solver's own checks.
+/// `check_mass` for what is refused on top of the solver's own checks.
 pub fn solve(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
