@@ -3,8 +3,9 @@
 //! columns as NumPy arrays).
 //!
 //! The solver converts its branches into the plain records below ([`LevelResult`],
-//! [`PointRecord`], ...); the writers only format them. Numbers are written in Rust's shortest
-//! round-trip exponent form (`{:e}`), so reading a file back gives the same `f64` bit for bit.
+//! [`PointRecord`], ...); the writers only format them. Numbers are written in the shortest
+//! round-trip exponent form (`{:e}`'s form, `ryu`'s digits in the tables: `csv::push_number`),
+//! so reading a file back gives the same `f64` bit for bit.
 
 mod csv;
 mod manifest;
