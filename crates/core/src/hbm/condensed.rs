@@ -413,24 +413,6 @@ impl<'m> CondensedHbm<'m> {
                     let col = c2 * q + off + b;
                     let jcol = je.col_as_slice(c2 * d + b);
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    if d == 1 {
-                        // One direction (a slider): the products straight into the column.
-                        let g = jcol[0];
-                        for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off)) {
-                            *out += h * g;
-                        }
-                        for k in 1..=self.plan.n_harmonics() {
-                            let h = harmonic[k - 1].h.col_as_slice(off);
-                            let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
-                            let (gc, gs) = (jcol[cos_index(k)], jcol[sin_index(k)]);
-                            let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
-                            for ((oc, os), h) in cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(h) {
-                                *oc += h.re * gc + h.im * gs;
-                                *os += -h.im * gc + h.re * gs;
-                            }
-                        }
-                        continue;
-                    }
                     sums.fill(c64::new(0.0, 0.0));
                     for a in 0..d {
                         let g = jcol[a];

@@ -767,21 +767,27 @@ mod tests {
         }
     }
 
+    /// One evaluation with its Jacobian of `law` in closed form and of the same law marched
+    /// with the chain rule ([`Marched`]): the AFTs, force harmonics and Jacobians.
+    fn closed_form_and_chain_rule(law: &Jenkins, plan: &AftPlan, u: &[f64]) -> [(ElementAft, Vec<f64>, Mat<f64>); 2] {
+        let n = plan.n_coeffs();
+        let marched = Marched(law.clone());
+        let laws: [&dyn Element; 2] = [law, &marched];
+        laws.map(|law| {
+            let (mut g, mut jac, mut dg_domega) = (vec![0.0; n], Mat::zeros(n, n), vec![0.0; n]);
+            let mut aft = ElementAft::new(law, plan);
+            aft.evaluate(law, plan, 500.0, u, &mut g, Some((jac.as_mut(), &mut dg_domega))).unwrap();
+            (aft, g, jac)
+        })
+    }
+
     #[test]
     fn closed_form_slider_from_the_known_start_equals_the_chain_rule_over_the_march() {
         let plan = AftPlan::new(5, 256).unwrap();
         let n = plan.n_coeffs();
+        let law = Jenkins::replacing_stiffness(1e6, 100.0).unwrap();
         for amplitude in [2e-4, 1e-3] {
-            let law = Jenkins::replacing_stiffness(1e6, 100.0).unwrap();
-            let marched = Marched(law.clone());
-            let u = motion(amplitude);
-            let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
-            let (mut j1, mut j2) = (Mat::zeros(n, n), Mat::zeros(n, n));
-            let (mut w1, mut w2) = (vec![0.0; n], vec![0.0; n]);
-            let mut a1 = ElementAft::new(&law, &plan);
-            let mut a2 = ElementAft::new(&marched, &plan);
-            a1.evaluate(&law, &plan, 500.0, &u, &mut g1, Some((j1.as_mut(), &mut w1))).unwrap();
-            a2.evaluate(&marched, &plan, 500.0, &u, &mut g2, Some((j2.as_mut(), &mut w2))).unwrap();
+            let [(a1, g1, j1), (a2, g2, j2)] = closed_form_and_chain_rule(&law, &plan, &motion(amplitude));
             assert_eq!((a1.periods, a2.periods), (1, 2));
             let gs = g2.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             for i in 0..n {
@@ -806,15 +812,7 @@ mod tests {
             // 1e-5: stuck throughout; 9e-5: k u reaches F_c on one side only, so no periodic
             // start is known and the march begins at rest.
             for amplitude in [1e-5, 9e-5] {
-                let marched = Marched(law.clone());
-                let u = motion(amplitude);
-                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
-                let (mut j1, mut j2) = (Mat::zeros(n, n), Mat::zeros(n, n));
-                let (mut w1, mut w2) = (vec![0.0; n], vec![0.0; n]);
-                let mut a1 = ElementAft::new(&law, &plan);
-                let mut a2 = ElementAft::new(&marched, &plan);
-                a1.evaluate(&law, &plan, 500.0, &u, &mut g1, Some((j1.as_mut(), &mut w1))).unwrap();
-                a2.evaluate(&marched, &plan, 500.0, &u, &mut g2, Some((j2.as_mut(), &mut w2))).unwrap();
+                let [(a1, _, j1), (a2, _, j2)] = closed_form_and_chain_rule(&law, &plan, &motion(amplitude));
                 assert_eq!(a1.slipping, a2.slipping);
                 for i in 0..n {
                     for j in 0..n {

@@ -177,19 +177,8 @@ impl AftPlan {
     /// `count` columns (a stuck slider's Jacobian sums `P` over each stick phase). Equal to the
     /// direct sum to round-off of the running sums' size (`|Σ P| ≤ 2`, so ~1e-16 absolute).
     pub fn projection_sum(&self, first: usize, count: usize, sum: &mut [f64]) {
-        let nt = self.n_samples;
-        debug_assert!(first < nt && count <= nt);
-        let at = |j: usize| self.projection_prefix.col_as_slice(j);
-        let end = first + count;
-        if end <= nt {
-            for ((s, a), b) in sum.iter_mut().zip(at(end)).zip(at(first)) {
-                *s = a - b;
-            }
-        } else {
-            for (((s, a), b), c) in sum.iter_mut().zip(at(nt)).zip(at(first)).zip(at(end - nt)) {
-                *s = (a - b) + c;
-            }
-        }
+        sum.fill(0.0);
+        self.add_stretch(&self.projection_prefix, first, count, sum);
     }
 
     /// Add `Σ cos mθ_j` and `Σ sin mθ_j` over the `count ≤ n_t` samples from `first` on,
@@ -197,19 +186,24 @@ impl AftPlan {
     /// (at most 2N + 1): the Fourier sums of a stretch of constant weight (a slider's stick
     /// phase) without a transform. Exact to ~1 ulp of `n_t` per stretch.
     pub fn add_fourier_sums(&self, first: usize, count: usize, cos_sums: &mut [f64], sin_sums: &mut [f64]) {
+        self.add_stretch(&self.cos_prefix, first, count, cos_sums);
+        self.add_stretch(&self.sin_prefix, first, count, sin_sums);
+    }
+
+    /// Add to `sums` the stretch of `count` samples from `first` on (wrapping) of the sequences
+    /// whose running sums are `prefix`: one difference of two columns, or three columns.
+    fn add_stretch(&self, prefix: &Mat<f64>, first: usize, count: usize, sums: &mut [f64]) {
         let nt = self.n_samples;
         debug_assert!(first < nt && count <= nt);
+        let at = |j: usize| prefix.col_as_slice(j);
         let end = first + count;
-        for (prefix, sums) in [(&self.cos_prefix, cos_sums), (&self.sin_prefix, sin_sums)] {
-            let at = |j: usize| prefix.col_as_slice(j);
-            if end <= nt {
-                for ((s, a), b) in sums.iter_mut().zip(at(end)).zip(at(first)) {
-                    *s += a - b;
-                }
-            } else {
-                for (((s, a), b), c) in sums.iter_mut().zip(at(nt)).zip(at(first)).zip(at(end - nt)) {
-                    *s += (a - b) + c;
-                }
+        if end <= nt {
+            for ((s, a), b) in sums.iter_mut().zip(at(end)).zip(at(first)) {
+                *s += a - b;
+            }
+        } else {
+            for (((s, a), b), c) in sums.iter_mut().zip(at(nt)).zip(at(first)).zip(at(end - nt)) {
+                *s += (a - b) + c;
             }
         }
     }
