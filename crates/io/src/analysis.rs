@@ -6,6 +6,7 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::time::Instant;
 
 use faer::MatMut;
 use stickslip_core::continuation::{
@@ -97,6 +98,20 @@ pub struct LevelRun {
     pub note: Option<String>,
     /// For a branch that stopped short, what was found where it stopped (a singular balance).
     pub diagnosis: Option<String>,
+    /// Where the level's time went.
+    pub seconds: LevelSeconds,
+}
+
+/// The wall clock of a level's stages (s), so that a user sees what the located peaks and
+/// bifurcations add to the sweep.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LevelSeconds {
+    /// The continuation across the band, with each point's record (and stability).
+    pub sweep: f64,
+    /// The resonance peaks located between the points (peaks.csv).
+    pub peaks: f64,
+    /// The bifurcations located between the points (bifurcations.csv).
+    pub bifurcations: f64,
 }
 
 impl LevelRun {
@@ -381,12 +396,17 @@ impl<'a> LevelSweeper<'a> {
             error: None,
         };
         let (start, end) = (TWO_PI * study.sweep.start_hz, TWO_PI * study.sweep.end_hz);
+        let started = Instant::now();
         let branch: Branch = hbm.sweep_frequency(level, start, end, &options, &mut recorder)?;
+        let sweep_seconds = started.elapsed().as_secs_f64();
         if let Some(error) = recorder.error {
             return Err(error);
         }
         let PointRecorder { points, stabilities, tests, .. } = recorder;
+        let started = Instant::now();
         let peaks = locate_peaks(&mut hbm, &branch, level, selectors, &points);
+        let peaks_seconds = started.elapsed().as_secs_f64();
+        let started = Instant::now();
         // Folds and branch points at every sweep; period doublings and Neimark-Sacker
         // bifurcations where the stability is known.
         let mut found =
@@ -409,6 +429,8 @@ impl<'a> LevelSweeper<'a> {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let seconds =
+            LevelSeconds { sweep: sweep_seconds, peaks: peaks_seconds, bifurcations: started.elapsed().as_secs_f64() };
         let start_note = branch.points.first().filter(|p| p.lambda != TWO_PI * study.sweep.start_hz).map(|p| {
             format!(
                 "the band starts where a harmonic of the excitation meets a natural frequency of the undamped linear model (its linear response is infinite there): the branch starts {:.3e} Hz off, at {} Hz",
@@ -442,6 +464,7 @@ impl<'a> LevelSweeper<'a> {
             evaluations: branch.calls.residuals,
             result: LevelResult { level_n: level, points, peaks, bifurcations },
             termination: branch.termination,
+            seconds,
         })
     }
 }

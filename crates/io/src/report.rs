@@ -432,7 +432,16 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
     } else {
         h.push_str("<table>\n<tr><th>stage</th><th>time (s)</th></tr>\n");
         for (stage, seconds) in &data.timings {
-            let _ = writeln!(h, "<tr><td>{}</td><td class=\"num\">{}</td></tr>", escape(stage), fixed(*seconds, 3));
+            // A stage indented by spaces is a part of the one above it.
+            let name = stage.trim_start();
+            let indent = stage.len() - name.len();
+            let _ = writeln!(
+                h,
+                "<tr><td style=\"padding-left:{}em\">{}</td><td class=\"num\">{}</td></tr>",
+                0.5 + indent as f64,
+                escape(name),
+                fixed(*seconds, 4)
+            );
         }
         h.push_str("</table>\n");
     }
@@ -913,7 +922,7 @@ mod tests {
         // The share of the load each mode takes, beside its frequency.
         assert!(html.contains("<td class=\"num\">238.205</td><td>yes</td><td class=\"num\">0.7500</td>"), "{html}");
         assert!(html.contains("<td class=\"num\">1000</td><td class=\"num\">0</td><td class=\"bad\">"));
-        assert!(html.contains("1.235"));
+        assert!(html.contains("1.2346"));
         assert!(html.contains("No figures."));
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -21,6 +21,10 @@ fn levels(study: &Study) -> Vec<LevelResult> {
         .map(|&level| {
             let run = run_level(study, &model, &excitation, &outputs, level, &mut Silent).unwrap();
             assert!(run.is_complete(), "{level} N: {:?}", run.termination);
+            // Each stage's wall clock measured (the report's timings).
+            let s = run.seconds;
+            assert!(s.sweep > 0.0 && s.sweep.is_finite(), "{s:?}");
+            assert!([s.peaks, s.bifurcations].iter().all(|t| t.is_finite() && *t >= 0.0), "{s:?}");
             run.result
         })
         .collect()

@@ -207,6 +207,9 @@ pub(crate) fn results_dict<'py>(py: Python<'py>, runs: &[LevelRun]) -> PyResult<
             l.set_item("ending", r.ending())?;
             l.set_item("newton_iterations", r.newton_iterations)?;
             l.set_item("evaluations", r.evaluations)?;
+            l.set_item("sweep_s", r.seconds.sweep)?;
+            l.set_item("located_peaks_s", r.seconds.peaks)?;
+            l.set_item("located_bifurcations_s", r.seconds.bifurcations)?;
             Ok(l)
         })
         .collect::<PyResult<Vec<_>>>()?;

@@ -84,9 +84,10 @@ pub fn main(args: Args) -> anyhow::Result<()> {
                 bars.suspend(|| eprintln!("level {level} N: {note}"));
             }
             bar.finish_with_message(format!(
-                "{} points, {}, {secs:.2} s",
+                "{} points, {}, {secs:.2} s (of which the located peaks {:.3} s)",
                 run.result.points.len(),
-                describe_termination(&run.termination)
+                describe_termination(&run.termination),
+                run.seconds.peaks
             ));
             Ok((run, secs))
         })
@@ -95,6 +96,11 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     let elapsed = started.elapsed();
     for (run, secs) in &runs {
         timings.push((format!("level {} N", run.result.level_n), *secs));
+        // Indented: parts of the level above.
+        let stages = &run.seconds;
+        timings.push(("  sweep".into(), stages.sweep));
+        timings.push(("  located peaks".into(), stages.peaks));
+        timings.push(("  located bifurcations".into(), stages.bifurcations));
     }
     timings.push(("all levels (wall clock)".into(), elapsed.as_secs_f64()));
     let runs: Vec<LevelRun> = runs.into_iter().map(|(run, _)| run).collect();

@@ -82,7 +82,8 @@ class Results:
         self.columns: list = list(data["columns"])
         self.table: np.ndarray = data["table"]
         #: Per level: ``level_N``, ``points``, ``complete``, ``ending`` (why the branch ended),
-        #: ``newton_iterations``, ``evaluations``.
+        #: ``newton_iterations``, ``evaluations``, and the wall clock (s) of its stages:
+        #: ``sweep_s``, ``located_peaks_s``, ``located_bifurcations_s``.
         self.levels: list = data["levels"]
         self.outputs: list = data["outputs"]
         self.elements: list = data["elements"]
