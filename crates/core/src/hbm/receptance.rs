@@ -67,6 +67,9 @@ pub struct DirectReceptance {
     damping: Mat<f64>,
     /// `[V F]` (n × (q+1)).
     rhs: Mat<c64>,
+    /// The mass-normalised undamped modes, for what is written in modal coordinates (Hill's
+    /// method).
+    modes: Modes,
 }
 
 /// A parameter of the linear part with respect to which [`ModalReceptance::matrix_with`]
@@ -175,8 +178,8 @@ impl Receptance {
                 pairs,
             }))
         } else {
-            // Check M > 0 and K > 0 the same way as the modal path, so both fail alike.
-            model.dense_modes()?;
+            // M > 0 and K > 0 checked the same way as the modal path, so both fail alike.
+            let modes = model.dense_modes()?;
             let Damping::Matrix(d) = &model.damping else { unreachable!("non-modal damping is a matrix") };
             let rhs = Mat::from_fn(n, q + 1, |l, j| c64::new(if j < q { directions[j][l] } else { force[l] }, 0.0));
             Ok(Receptance::Direct(DirectReceptance {
@@ -184,6 +187,7 @@ impl Receptance {
                 stiffness: model.stiffness.to_dense(),
                 damping: d.to_dense(),
                 rhs,
+                modes,
             }))
         }
     }
@@ -497,6 +501,25 @@ impl ModalReceptance {
 }
 
 impl DirectReceptance {
+    /// Natural circular frequencies ω_r of the undamped modes (rad/s, increasing).
+    pub fn natural_frequencies(&self) -> &[f64] {
+        &self.modes.omega
+    }
+
+    /// The damping matrix in the mass-normalised undamped modes, `Φᵀ D Φ` (m × m): full, as
+    /// `D` is not proportional (the modal equations `q̈ + Φᵀ D Φ q̇ + Λ q` stay coupled).
+    pub fn modal_damping(&self) -> Mat<f64> {
+        let phi = &self.modes.shapes;
+        phi.transpose() * &self.damping * phi
+    }
+
+    /// `A = Vᵀ Φ` (q × m): each mode seen from the nonlinear directions.
+    pub fn participation(&self) -> Mat<f64> {
+        let q = self.rhs.ncols() - 1;
+        let phi = &self.modes.shapes;
+        Mat::from_fn(q, phi.ncols(), |i, r| (0..phi.nrows()).map(|l| self.rhs[(l, i)].re * phi[(l, r)]).sum())
+    }
+
     fn dynamic_stiffness(&self, omega: f64) -> Mat<c64> {
         let n = self.mass.nrows();
         Mat::from_fn(n, n, |i, j| {

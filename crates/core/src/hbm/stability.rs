@@ -17,7 +17,10 @@
 //! displacement, [`super::condensed`]), where `s` would enter through the receptance at the
 //! complex frequencies `kΩ − is`: a rational, not a polynomial, eigenproblem. In the
 //! coordinates of the mass-normalised modes of the linear model (the same modes the modal
-//! receptance sums), `I`, `C = diag(c_r)` and `Λ = diag(ω_r²)` are diagonal and the joints enter
+//! receptance sums), `I` and `Λ = diag(ω_r²)` are diagonal, `C = Φᵀ D Φ` is diagonal
+//! (`diag(c_r)`) for proportional or modal damping and full for a general damping matrix `D`
+//! (the modal equations then stay coupled through it, the eigenproblem is the same), and the
+//! joints enter
 //! through the low-rank term `K_nl = Aᵀ J A`, `A = Vᵀ Φ` (q × m) and `J = ∂G/∂x` the elements'
 //! harmonic Jacobian that Newton already uses: the quadratic problem is polynomial, of size
 //! `m(2N+1)`, and its companion form is an ordinary real eigenproblem.
@@ -26,7 +29,10 @@
 //! through their residual flexibility `R = Σ_{r>m} a_r a_rᵀ / ω_r²` (a static correction), so the
 //! joints' stiffness seen by the kept modes is `Aᵀ J (I + R J)⁻¹ A`. With every mode kept this is
 //! Hill's method on the whole model; the default keeps the modes that a harmonic of the band can
-//! reach (see [`HillSettings`]).
+//! reach (see [`HillSettings`]). With a general damping matrix, the modes left out of the kept
+//! set are condensed the same way (statically: their damping, and its coupling to the kept
+//! modes, are dropped), so the exponents are exact only when every mode is kept: a model
+//! whose modes all lie below the `HillSettings` bound, as small models' do.
 //!
 //! **Sorting.** The truncated Hill matrix has `2m(2N+1)` eigenvalues, each physical exponent
 //! repeated (approximately) at `s + ijΩ`. The `2m` with the smallest `|Im s|` are the
@@ -115,7 +121,9 @@ impl Stability {
 #[derive(Clone, Debug)]
 pub struct Hill {
     omega_r: Vec<f64>,
-    c_r: Vec<f64>,
+    /// The damping of the kept modes, `C = Φᵀ D Φ` (m × m: diagonal unless the model has a
+    /// general damping matrix).
+    damping: Mat<f64>,
     /// `Vᵀ φ_r` of the kept modes (q × m).
     a: Mat<f64>,
     /// Residual flexibility of the other modes on the directions (q × q).
@@ -127,8 +135,16 @@ pub struct Hill {
 impl Hill {
     /// Prepare Hill's method on the modes of `receptance`'s linear model.
     pub fn new(receptance: &Receptance, settings: HillSettings) -> Result<Self, StabilityError> {
-        let Receptance::Modal(modal) = receptance else { return Err(StabilityError::GeneralDamping) };
-        let (omega_r, c_r, a) = (modal.natural_frequencies(), modal.damping_coefficients(), modal.participation());
+        let (omega_r, damping, a) = match receptance {
+            Receptance::Modal(modal) => {
+                let c_r = modal.damping_coefficients();
+                let damping = Mat::from_fn(c_r.len(), c_r.len(), |r, l| if r == l { c_r[r] } else { 0.0 });
+                (modal.natural_frequencies(), damping, modal.participation().to_owned())
+            }
+            Receptance::Direct(direct) => {
+                (direct.natural_frequencies(), direct.modal_damping(), direct.participation())
+            }
+        };
         let q = a.nrows();
         let kept = omega_r.iter().take_while(|&&w| w <= settings.max_omega).count().clamp(1, settings.max_modes);
         let kept = kept.min(omega_r.len());
@@ -137,7 +153,7 @@ impl Hill {
         });
         Ok(Hill {
             omega_r: omega_r[..kept].to_vec(),
-            c_r: c_r[..kept].to_vec(),
+            damping: damping.submatrix(0, 0, kept, kept).to_owned(),
             a: a.subcols(0, kept).to_owned(),
             residual,
             split_parity: true,
@@ -183,23 +199,33 @@ impl Hill {
         }
         let real = |v: f64| c64::new(v, 0.0);
         for r in 0..m {
-            let (w2, c) = (self.omega_r[r] * self.omega_r[r], self.c_r[r]);
-            // Harmonic 0: Δ₀ = ω_r², Δ₁ = c_r.
+            let w2 = self.omega_r[r] * self.omega_r[r];
+            // Harmonic 0: Δ₀ = Λ, Δ₁ = C.
             companion[(size + r, r)] -= real(w2);
-            companion[(size + r, size + r)] -= real(c);
             for k in 1..=harmonics {
                 let kw = k as f64 * omega;
                 let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
                 // ∇ (c, s) = kΩ (s, −c); ∇² = −(kΩ)².
-                // Δ₀ = (ω_r² − (kΩ)²) I + c_r ∇,   Δ₁ = c_r I + 2∇.
+                // Δ₀ = (Λ − (kΩ)²) I + C ∇,   Δ₁ = C + 2∇.
                 companion[(size + ic, ic)] -= real(w2 - kw * kw);
                 companion[(size + is, is)] -= real(w2 - kw * kw);
-                companion[(size + ic, is)] -= real(c * kw);
-                companion[(size + is, ic)] += real(c * kw);
-                companion[(size + ic, size + ic)] -= real(c);
-                companion[(size + is, size + is)] -= real(c);
                 companion[(size + ic, size + is)] -= real(2.0 * kw);
                 companion[(size + is, size + ic)] += real(2.0 * kw);
+            }
+            for l in 0..m {
+                let c = self.damping[(r, l)];
+                if c == 0.0 {
+                    continue;
+                }
+                companion[(size + r, size + l)] -= real(c);
+                for k in 1..=harmonics {
+                    let kw = k as f64 * omega;
+                    let (ic, is) = (cos_index(k) * m, sin_index(k) * m);
+                    companion[(size + ic + r, is + l)] -= real(c * kw);
+                    companion[(size + is + r, ic + l)] += real(c * kw);
+                    companion[(size + ic + r, size + ic + l)] -= real(c);
+                    companion[(size + is + r, size + is + l)] -= real(c);
+                }
             }
         }
         let failed = StabilityError::Eigen { size: 2 * size };
@@ -301,16 +327,31 @@ impl Hill {
     fn add_modal(&self, omega: f64, s: c64, harmonics: usize, t: &mut Mat<c64>) {
         let m = self.n_modes();
         for r in 0..m {
-            let (w2, c) = (self.omega_r[r] * self.omega_r[r], self.c_r[r]);
-            t[(r, r)] += s * s + s * c + w2;
+            let w2 = self.omega_r[r] * self.omega_r[r];
+            t[(r, r)] += s * s + w2;
             for k in 1..=harmonics {
                 let kw = k as f64 * omega;
                 let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
-                let diagonal = s * s + s * c + (w2 - kw * kw);
+                let diagonal = s * s + (w2 - kw * kw);
                 t[(ic, ic)] += diagonal;
                 t[(is, is)] += diagonal;
-                t[(ic, is)] += s * (2.0 * kw) + c * kw;
-                t[(is, ic)] -= s * (2.0 * kw) + c * kw;
+                t[(ic, is)] += s * (2.0 * kw);
+                t[(is, ic)] -= s * (2.0 * kw);
+            }
+            for l in 0..m {
+                let c = self.damping[(r, l)];
+                if c == 0.0 {
+                    continue;
+                }
+                t[(r, l)] += s * c;
+                for k in 1..=harmonics {
+                    let kw = k as f64 * omega;
+                    let (ic, is) = (cos_index(k) * m, sin_index(k) * m);
+                    t[(ic + r, ic + l)] += s * c;
+                    t[(is + r, is + l)] += s * c;
+                    t[(ic + r, is + l)] += c * kw;
+                    t[(is + r, ic + l)] -= c * kw;
+                }
             }
         }
     }
@@ -320,13 +361,24 @@ impl Hill {
         let m = self.n_modes();
         let mut y = vec![c64::new(0.0, 0.0); x.len()];
         for r in 0..m {
-            let c = self.c_r[r];
-            y[r] = (s * 2.0 + c) * x[r];
+            y[r] = s * 2.0 * x[r];
             for k in 1..=harmonics {
                 let kw2 = 2.0 * k as f64 * omega;
                 let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
-                y[ic] = (s * 2.0 + c) * x[ic] + x[is] * kw2;
-                y[is] = (s * 2.0 + c) * x[is] - x[ic] * kw2;
+                y[ic] = s * 2.0 * x[ic] + x[is] * kw2;
+                y[is] = s * 2.0 * x[is] - x[ic] * kw2;
+            }
+            for l in 0..m {
+                let c = self.damping[(r, l)];
+                if c == 0.0 {
+                    continue;
+                }
+                y[r] += x[l] * c;
+                for k in 1..=harmonics {
+                    let (ic, is) = (cos_index(k) * m, sin_index(k) * m);
+                    y[ic + r] += x[ic + l] * c;
+                    y[is + r] += x[is + l] * c;
+                }
             }
         }
         y

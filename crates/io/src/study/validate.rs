@@ -126,16 +126,6 @@ pub(crate) fn parse(text: &str, file: &Path) -> Result<Study, StudyError> {
 
     let excitation = excitation(&src, &raw.excitation, &loads)?;
     let sweep = sweep(&src, &raw.sweep)?;
-    // Hill's method is written in the modes (docs/stability.md): a general damping matrix
-    // cannot be used there.
-    if let (true, DampingSpec::Matrix(_) | DampingSpec::File(_)) = (hbm.stability, &damping) {
-        let key = raw.harmonic_balance.as_ref().and_then(|h| h.get_ref().stability.as_ref()).map(|b| b.span());
-        return Err(src.invalid(
-            &key.unwrap_or(0..0),
-            "[harmonic_balance]: stability = true needs damping that is diagonal in the modes ([damping] alpha/beta or \
-             modal_ratios): Hill's method is written in the modes here, and this study gives a damping matrix",
-        ));
-    }
     let continuation = continuation(&src, raw.continuation.as_ref(), &sweep)?;
 
     let mut outputs = Vec::new();
