@@ -79,11 +79,6 @@ impl HillSettings {
 /// Why stability cannot be computed.
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum StabilityError {
-    #[error(
-        "stability needs damping that is diagonal in the modes (Rayleigh, modal or none): Hill's method is \
-         written in modal form here, and the model has a general damping matrix"
-    )]
-    GeneralDamping,
     #[error("the Hill eigenproblem ({size} × {size}) did not converge")]
     Eigen { size: usize },
     #[error("the joints' Jacobian has size {got}, expected {expected}")]
@@ -322,8 +317,9 @@ impl Hill {
     }
 
     /// Adds the modal part of Hill's quadratic matrix at `s`, `s² I + s Δ₁ + Δ₀`, to `t`
-    /// (harmonic 0: `Δ₀ = ω_r²`, `Δ₁ = c_r`; harmonic k: `Δ₀ = (ω_r² − (kΩ)²) I + c_r ∇`,
-    /// `Δ₁ = c_r I + 2∇`, `∇ (c, s) = kΩ (s, −c)`), 2 × 2 blocks per mode and harmonic.
+    /// (harmonic 0: `Δ₀ = Λ`, `Δ₁ = C`; harmonic k: `Δ₀ = (Λ − (kΩ)²) I + C ∇`,
+    /// `Δ₁ = C + 2∇`, `∇ (c, s) = kΩ (s, −c)`): 2 × 2 blocks per mode and harmonic, coupled
+    /// between modes by the off-diagonal terms of `C`.
     fn add_modal(&self, omega: f64, s: c64, harmonics: usize, t: &mut Mat<c64>) {
         let m = self.n_modes();
         for r in 0..m {
