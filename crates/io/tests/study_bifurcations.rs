@@ -83,3 +83,66 @@ fn the_friction_examples_have_no_fold_and_no_branch_point() {
         assert_eq!(level.bifurcations, [], "{} N", level.level_n);
     }
 }
+
+/// Krack & Gross's forced two-DOF oscillator with cubic springs and dampers on its springs (a
+/// general damping matrix), NLvib's `twoDOFoscillator_cubicSpring`, as a study (Hz in the file).
+const KRACK_GROSS: &str = r#"
+[model]
+dofs = ["x1", "x2"]
+mass = [1.0, 0.05]
+stiffness = [[1.0453, -0.0453], [-0.0453, 0.0453]]
+
+[damping]
+matrix = [[0.015, -0.013], [-0.013, 0.013]]
+
+[[load]]
+name = "force"
+dof = "x1"
+
+[[joint]]
+name = "ground"
+law = "cubic"
+dof = "x1"
+k3 = 1.0
+
+[[joint]]
+name = "between"
+law = "cubic"
+between = ["x1", "x2"]
+k3 = 0.0042
+
+[excitation]
+load = "force"
+levels = [0.11]
+
+[sweep]
+start_hz = 0.12732395447351627
+end_hz = 0.2228169203286535
+
+[harmonic_balance]
+harmonics = 7
+samples = 29
+stability = true
+
+[[output]]
+name = "x1"
+dof = "x1"
+"#;
+
+#[test]
+fn a_run_with_a_damping_matrix_lists_the_published_neimark_sacker_bifurcations() {
+    // The crossings located to round-off by shooting (bench/peer/nlvib_neimark_sacker.py), in
+    // Hz; the core test `stability_published_neimark_sacker.rs` compares them with NLvib's run.
+    let shooting = [1.112_711_239, 1.195_736_669].map(|w: f64| w / std::f64::consts::TAU);
+    let study = Study::parse(KRACK_GROSS, "study.toml").unwrap();
+    let level = &levels(&study)[0];
+    let ns: Vec<_> = level.bifurcations.iter().filter(|b| b.kind == "Neimark-Sacker").collect();
+    assert_eq!(ns.len(), 2, "{:?}", level.bifurcations);
+    for (b, f) in ns.iter().zip(shooting) {
+        // As in the core test (measured 1e-10): the run's own steps, the same location.
+        assert!(b.located && (b.frequency_hz - f).abs() <= 1e-8 * f, "{} Hz against {f}", b.frequency_hz);
+        assert!(b.exponent_im > 0.0);
+    }
+    let folds = level.bifurcations.iter().filter(|b| b.kind == "fold").count();
+    assert_eq!(folds, 2, "{:?}", level.bifurcations);
+}
