@@ -131,17 +131,7 @@ impl Chart {
             let y = log_axis(y0, y1);
             (y0, y1) = (y.start, y.end);
             let mut chart = chart.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(e)?;
-            // Over more than a decade, label the decades only (1e-7, 1e-6, ...): the ticks in
-            // between (2e-7, 3e-7, ...) crowd the axis; over less, every tick.
-            let per_decade = (y1 / y0).log10() > 1.0;
-            let label = move |y: &f64| {
-                let exponent = y.log10();
-                if per_decade && (exponent - exponent.round()).abs() > 1e-9 {
-                    String::new()
-                } else {
-                    format!("{y:.0e}")
-                }
-            };
+            let label = move |y: &f64| log_tick(*y, y0, y1);
             chart
                 .configure_mesh()
                 .x_desc(&self.x_label)
@@ -254,6 +244,24 @@ impl Chart {
 /// A tick label: plain decimals for moderate magnitudes, exponent form otherwise; a tick within
 /// round-off of zero on an axis of width `span` is 0 (the tick positions are computed in
 /// floating point: "-1.39e-17" appeared on slider-velocity plots).
+/// The label of the tick at `y` of a log axis from `y0` to `y1`. Where the axis holds two
+/// decades or more, the decades only (1e-7, 1e-6, ...): the ticks in between (2e-7, 3e-7, ...)
+/// would crowd it. Where it holds one or none (a resonance seen over less than two decades),
+/// the decades alone would leave one label or none to read values by: the ticks at 1, 2, 3
+/// and 5 of each decade are labelled too.
+fn log_tick(y: f64, y0: f64, y1: f64) -> String {
+    let exponent = y.log10();
+    let decade = (exponent - exponent.round()).abs() <= 1e-9;
+    let decades_inside = (y1.log10() + 1e-9).floor() - (y0.log10() - 1e-9).ceil() + 1.0;
+    let mantissa = y / 10f64.powf(exponent.floor());
+    let readable = [1.0, 2.0, 3.0, 5.0].iter().any(|m| (mantissa - m).abs() <= 1e-6 * m);
+    if decade || (decades_inside < 2.0 && readable) {
+        format!("{y:.0e}")
+    } else {
+        String::new()
+    }
+}
+
 fn tick(v: f64, span: f64) -> String {
     let v = if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v };
     if v == 0.0 || (1e-2..1e5).contains(&v.abs()) {
@@ -916,6 +924,24 @@ pub fn plot_backbone(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn log_axes_label_the_decades_or_enough_ticks_to_read_values_by() {
+        use super::log_tick;
+        // Three decades: the decades only.
+        let (y0, y1) = (2e-7, 5e-4);
+        assert_eq!(log_tick(1e-6, y0, y1), "1e-6");
+        assert_eq!(log_tick(2e-6, y0, y1), "");
+        // Less than a decade, across 1e0 (a resonance's top): 1, 2, 3 and 5 of the decade.
+        let (y0, y1) = (0.73, 7.05);
+        let labels: Vec<String> =
+            [0.8, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0].iter().map(|y| log_tick(*y, y0, y1)).collect();
+        assert_eq!(labels, ["", "1e0", "2e0", "3e0", "", "5e0", "", ""]);
+        // Inside one decade, no decade tick at all: still labels.
+        assert_eq!(log_tick(3e-4, 2.1e-4, 9e-4), "3e-4");
+        // Two decades exactly (1e-3 to 1e-1 inside): the decades only.
+        assert_eq!(log_tick(2e-2, 8e-4, 0.2), "");
+    }
+
     #[test]
     fn ticks_at_round_off_of_zero_read_zero() {
         // The tick at zero of a velocity axis [-0.14, 0.12] came out as -1.39e-17.
