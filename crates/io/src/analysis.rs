@@ -20,7 +20,7 @@ use stickslip_core::hbm::{
     floquet_bifurcations, folds_and_branch_points, nonlinear_mode, stability_at_last_evaluation, sweep_frequency,
     sweep_level, Backbone, BranchStabilityError, CondensedHbm, FrequencySweep, HbmError,
     HbmSettings as CoreHbmSettings, Hill, HillSettings, NegativeDamping, NonlinearModeError, NonlinearModeSettings,
-    Stability, SweepError,
+    Receptance, Stability, SweepError,
 };
 use stickslip_core::model::NonlinearModel;
 use stickslip_core::post::{
@@ -85,6 +85,20 @@ pub fn run_nonlinear_mode<O: Observer + ?Sized>(
         nonlinear_mode(model, &settings, spec.amplitude_start, spec.amplitude_end, &vectors, &options, observer)
             .map(|b| (b, chosen.iter().map(|o| o.name.clone()).collect()));
     Some(result)
+}
+
+/// With a general damping matrix, Hill's method drops the damping of the modes it does not keep
+/// and its coupling to the kept ones (docs/stability.md): said when it keeps fewer modes than
+/// the model has, so that the exponents are read as approximate.
+fn stability_note(hill: &Hill, receptance: &Receptance) -> Option<String> {
+    let Receptance::Direct(direct) = receptance else { return None };
+    let all = direct.natural_frequencies().len();
+    (hill.n_modes() < all).then(|| {
+        format!(
+            "stability: Hill's method keeps {} of the model's {all} modes (natural frequencies up to (N + 1) times the band's top, at most 24); with a damping matrix, the damping of the others and its coupling to the kept ones are left out, so the Floquet exponents are approximate",
+            hill.n_modes()
+        )
+    })
 }
 
 /// The result of one level: the records of every converged point, and why the branch ended.
@@ -170,6 +184,8 @@ pub struct LevelSweeper<'a> {
     study: &'a Study,
     hbm: Balance<'a>,
     hill: Option<Hill>,
+    /// What the user should know of the stability computed (see [`stability_note`]).
+    stability_note: Option<String>,
     selectors: Vec<OutputSelector>,
 }
 
@@ -376,7 +392,11 @@ impl<'a> LevelSweeper<'a> {
             }
             (false, _) => None,
         };
-        Ok(LevelSweeper { study, hbm, hill, selectors: selectors(outputs) })
+        let stability_note = match (&hill, &hbm) {
+            (Some(hill), Balance::Penalty(hbm)) => stability_note(hill, hbm.receptance()),
+            _ => None,
+        };
+        Ok(LevelSweeper { study, hbm, hill, stability_note, selectors: selectors(outputs) })
     }
 
     /// Sweep the band at force `level` (N), as [`run_level`].
@@ -445,7 +465,7 @@ impl<'a> LevelSweeper<'a> {
                 r.restarted_at / TWO_PI
             )
         });
-        let note = start_note.into_iter().chain(resumed_notes).collect::<Vec<_>>();
+        let note = start_note.into_iter().chain(resumed_notes).chain(self.stability_note.clone()).collect::<Vec<_>>();
         let note = (!note.is_empty()).then(|| note.join("; "));
         // A branch that stopped: at its last point, or where Newton last stopped beyond it.
         let singular_note = match (&branch.termination, branch.points.last(), &mut hbm) {

@@ -146,3 +146,29 @@ fn a_run_with_a_damping_matrix_lists_the_published_neimark_sacker_bifurcations()
     let folds = level.bifurcations.iter().filter(|b| b.kind == "fold").count();
     assert_eq!(folds, 2, "{:?}", level.bifurcations);
 }
+
+#[test]
+fn a_run_says_when_hill_leaves_out_modes_of_a_model_with_a_damping_matrix() {
+    let run = |text: &str| {
+        let study = Study::parse(text, "study.toml").unwrap();
+        let (model, excitation, outputs) = study.build_model().unwrap();
+        run_level(&study, &model, &excitation, &outputs, 0.11, &mut Silent).unwrap().note
+    };
+    // Every mode kept (both below (N + 1) times the band's top): nothing to say.
+    assert_eq!(run(KRACK_GROSS), None);
+    // A third mass on a stiff spring to the first: its mode (~100 rad/s) lies above the 11.2
+    // rad/s Hill's method keeps.
+    let three = KRACK_GROSS
+        .replace(r#"dofs = ["x1", "x2"]"#, r#"dofs = ["x1", "x2", "x3"]"#)
+        .replace("mass = [1.0, 0.05]", "mass = [1.0, 0.05, 1.0]")
+        .replace(
+            "stiffness = [[1.0453, -0.0453], [-0.0453, 0.0453]]",
+            "stiffness = [[10001.0453, -0.0453, -1e4], [-0.0453, 0.0453, 0.0], [-1e4, 0.0, 1e4]]",
+        )
+        .replace(
+            "matrix = [[0.015, -0.013], [-0.013, 0.013]]",
+            "matrix = [[0.015, -0.013, 0.0], [-0.013, 0.013, 0.0], [0.0, 0.0, 0.0]]",
+        );
+    let note = run(&three).expect("a note");
+    assert!(note.contains("keeps 2 of the model's 3 modes") && note.contains("approximate"), "{note}");
+}
