@@ -16,7 +16,7 @@
 //! exact (`bench/peer/nlvib_neimark_sacker.py`: shooting with the monodromy matrix from the
 //! variational equations integrated to 1e-12, and the crossing located by bisection in Ω), and
 //! NLvib's own run of the example (GNU Octave, the published script unchanged but for its
-//! plots) is quoted beside them.
+//! plots and the form of its solver options) is quoted beside them.
 use faer::Mat;
 use stickslip_core::continuation::{Accepted, Options, PointObserver, Problem, TerminationReason, TestFunctions};
 use stickslip_core::elements::{CubicSpring, Element};
