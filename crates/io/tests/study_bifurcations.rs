@@ -85,56 +85,17 @@ fn the_friction_examples_have_no_fold_and_no_branch_point() {
 }
 
 /// Krack & Gross's forced two-DOF oscillator with cubic springs and dampers on its springs (a
-/// general damping matrix), NLvib's `twoDOFoscillator_cubicSpring`, as a study (Hz in the file).
-const KRACK_GROSS: &str = r#"
-[model]
-dofs = ["x1", "x2"]
-mass = [1.0, 0.05]
-stiffness = [[1.0453, -0.0453], [-0.0453, 0.0453]]
-
-[damping]
-matrix = [[0.015, -0.013], [-0.013, 0.013]]
-
-[[load]]
-name = "force"
-dof = "x1"
-
-[[joint]]
-name = "ground"
-law = "cubic"
-dof = "x1"
-k3 = 1.0
-
-[[joint]]
-name = "between"
-law = "cubic"
-between = ["x1", "x2"]
-k3 = 0.0042
-
-[excitation]
-load = "force"
-levels = [0.11]
-
-[sweep]
-start_hz = 0.12732395447351627
-end_hz = 0.2228169203286535
-
-[harmonic_balance]
-harmonics = 7
-samples = 29
-stability = true
-
-[[output]]
-name = "x1"
-dof = "x1"
-"#;
+/// general damping matrix), NLvib's `twoDOFoscillator_cubicSpring`, as the shipped example.
+fn krack_gross() -> String {
+    std::fs::read_to_string(example("two-dof-neimark-sacker")).unwrap()
+}
 
 #[test]
 fn a_run_with_a_damping_matrix_lists_the_published_neimark_sacker_bifurcations() {
     // The crossings located to round-off by shooting (bench/peer/nlvib_neimark_sacker.py), in
     // Hz; the core test `stability_published_neimark_sacker.rs` compares them with NLvib's run.
     let shooting = [1.112_711_239, 1.195_736_669].map(|w: f64| w / std::f64::consts::TAU);
-    let study = Study::parse(KRACK_GROSS, "study.toml").unwrap();
+    let study = Study::parse(&krack_gross(), "study.toml").unwrap();
     let level = &levels(&study)[0];
     let ns: Vec<_> = level.bifurcations.iter().filter(|b| b.kind == "Neimark-Sacker").collect();
     assert_eq!(ns.len(), 2, "{:?}", level.bifurcations);
@@ -155,19 +116,19 @@ fn a_run_says_when_hill_leaves_out_modes_of_a_model_with_a_damping_matrix() {
         run_level(&study, &model, &excitation, &outputs, 0.11, &mut Silent).unwrap().note
     };
     // Every mode kept (both below (N + 1) times the band's top): nothing to say.
-    assert_eq!(run(KRACK_GROSS), None);
+    assert_eq!(run(&krack_gross()), None);
     // A third mass on a stiff spring to the first: its mode (~100 rad/s) lies above the 11.2
     // rad/s Hill's method keeps.
-    let three = KRACK_GROSS
+    let three = krack_gross()
         .replace(r#"dofs = ["x1", "x2"]"#, r#"dofs = ["x1", "x2", "x3"]"#)
-        .replace("mass = [1.0, 0.05]", "mass = [1.0, 0.05, 1.0]")
+        .replace("mass = [1.0, 0.05] ", "mass = [1.0, 0.05, 1.0] ")
         .replace(
-            "stiffness = [[1.0453, -0.0453], [-0.0453, 0.0453]]",
-            "stiffness = [[10001.0453, -0.0453, -1e4], [-0.0453, 0.0453, 0.0], [-1e4, 0.0, 1e4]]",
+            "stiffness = [[1.0453, -0.0453], [-0.0453, 0.0453]] ",
+            "stiffness = [[10001.0453, -0.0453, -1e4], [-0.0453, 0.0453, 0.0], [-1e4, 0.0, 1e4]] ",
         )
         .replace(
-            "matrix = [[0.015, -0.013], [-0.013, 0.013]]",
-            "matrix = [[0.015, -0.013, 0.0], [-0.013, 0.013, 0.0], [0.0, 0.0, 0.0]]",
+            "matrix = [[0.015, -0.013], [-0.013, 0.013]] ",
+            "matrix = [[0.015, -0.013, 0.0], [-0.013, 0.013, 0.0], [0.0, 0.0, 0.0]] ",
         );
     let note = run(&three).expect("a note");
     assert!(note.contains("keeps 2 of the model's 3 modes") && note.contains("approximate"), "{note}");
