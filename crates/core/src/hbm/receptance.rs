@@ -506,8 +506,8 @@ impl DirectReceptance {
         &self.modes.omega
     }
 
-    /// The damping matrix in the mass-normalised undamped modes, `Φᵀ D Φ` (m × m): full, as
-    /// `D` is not proportional (the modal equations `q̈ + Φᵀ D Φ q̇ + Λ q` stay coupled).
+    /// The damping matrix in the mass-normalised undamped modes, `Φᵀ D Φ` (m × m): full unless
+    /// `D` happens to be proportional (the modal equations `q̈ + Φᵀ D Φ q̇ + Λ q` stay coupled).
     pub fn modal_damping(&self) -> Mat<f64> {
         let phi = &self.modes.shapes;
         phi.transpose() * &self.damping * phi

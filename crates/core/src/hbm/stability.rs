@@ -20,9 +20,8 @@
 //! receptance sums), `I` and `Λ = diag(ω_r²)` are diagonal, `C = Φᵀ D Φ` is diagonal
 //! (`diag(c_r)`) for proportional or modal damping and full for a general damping matrix `D`
 //! (the modal equations then stay coupled through it, the eigenproblem is the same), and the
-//! joints enter
-//! through the low-rank term `K_nl = Aᵀ J A`, `A = Vᵀ Φ` (q × m) and `J = ∂G/∂x` the elements'
-//! harmonic Jacobian that Newton already uses: the quadratic problem is polynomial, of size
+//! joints enter through the low-rank term `K_nl = Aᵀ J A`, `A = Vᵀ Φ` (q × m) and `J = ∂G/∂x`
+//! the elements' harmonic Jacobian that Newton already uses: the quadratic problem is polynomial, of size
 //! `m(2N+1)`, and its companion form is an ordinary real eigenproblem.
 //!
 //! **Modes kept.** The first `m` modes carry the dynamics; the modes above act quasi-statically
