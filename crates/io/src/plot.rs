@@ -244,18 +244,19 @@ impl Chart {
 /// A tick label: plain decimals for moderate magnitudes, exponent form otherwise; a tick within
 /// round-off of zero on an axis of width `span` is 0 (the tick positions are computed in
 /// floating point: "-1.39e-17" appeared on slider-velocity plots).
-/// The label of the tick at `y` of a log axis from `y0` to `y1`. Where the axis holds two
-/// decades or more, the decades only (1e-7, 1e-6, ...): the ticks in between (2e-7, 3e-7, ...)
-/// would crowd it. Where it holds one or none (a resonance seen over less than two decades),
-/// the decades alone would leave one label or none to read values by: the ticks at 1, 2, 3
-/// and 5 of each decade are labelled too.
+/// The label of the tick at `y` of a log axis from `y0` to `y1`. Where the axis holds three
+/// decade ticks or more, the decades only (1e-7, 1e-6, ...): the ticks in between (2e-7, 3e-7,
+/// ...) would crowd it. Where it holds fewer (a resonance seen over a decade or two), the
+/// decades alone would leave one or two labels to read values by: the ticks at 1, 2 and 5 of
+/// each decade are labelled too, and at 3 where there is at most one decade tick.
 fn log_tick(y: f64, y0: f64, y1: f64) -> String {
     let exponent = y.log10();
     let decade = (exponent - exponent.round()).abs() <= 1e-9;
     let decades_inside = (y1.log10() + 1e-9).floor() - (y0.log10() - 1e-9).ceil() + 1.0;
     let mantissa = y / 10f64.powf(exponent.floor());
-    let readable = [1.0, 2.0, 3.0, 5.0].iter().any(|m| (mantissa - m).abs() <= 1e-6 * m);
-    if decade || (decades_inside < 2.0 && readable) {
+    let labelled: &[f64] = if decades_inside < 2.0 { &[2.0, 3.0, 5.0] } else { &[2.0, 5.0] };
+    let readable = labelled.iter().any(|m| (mantissa - m).abs() <= 1e-6 * m);
+    if decade || (decades_inside < 3.0 && readable) {
         format!("{y:.0e}")
     } else {
         String::new()
@@ -938,8 +939,13 @@ mod tests {
         assert_eq!(labels, ["", "1e0", "2e0", "3e0", "", "5e0", "", ""]);
         // Inside one decade, no decade tick at all: still labels.
         assert_eq!(log_tick(3e-4, 2.1e-4, 9e-4), "3e-4");
-        // Two decades exactly (1e-3 to 1e-1 inside): the decades only.
+        // Two decade ticks (1e0 and 1e1): 1, 2 and 5 of each decade.
+        let (y0, y1) = (0.7, 33.0);
+        let labels: Vec<String> = [0.8, 1.0, 2.0, 3.0, 5.0, 20.0, 30.0].iter().map(|y| log_tick(*y, y0, y1)).collect();
+        assert_eq!(labels, ["", "1e0", "2e0", "", "5e0", "2e1", ""]);
+        // Three (1e-3 to 1e-1 inside): the decades only.
         assert_eq!(log_tick(2e-2, 8e-4, 0.2), "");
+        assert_eq!(log_tick(1e-2, 8e-4, 0.2), "1e-2");
     }
 
     #[test]
