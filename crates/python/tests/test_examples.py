@@ -30,6 +30,7 @@ EXAMPLES = [
     ("lap-joint", "study.toml"),
     ("lap-joint", "study-jenkins.toml"),
     ("rigid-contact", "study.toml"),
+    ("two-dof-neimark-sacker", "study.toml"),
 ]
 
 
