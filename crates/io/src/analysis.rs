@@ -184,8 +184,6 @@ pub struct LevelSweeper<'a> {
     study: &'a Study,
     hbm: Balance<'a>,
     hill: Option<Hill>,
-    /// What the user should know of the stability computed (see [`stability_note`]).
-    stability_note: Option<String>,
     selectors: Vec<OutputSelector>,
 }
 
@@ -392,11 +390,7 @@ impl<'a> LevelSweeper<'a> {
             }
             (false, _) => None,
         };
-        let stability_note = match (&hill, &hbm) {
-            (Some(hill), Balance::Penalty(hbm)) => stability_note(hill, hbm.receptance()),
-            _ => None,
-        };
-        Ok(LevelSweeper { study, hbm, hill, stability_note, selectors: selectors(outputs) })
+        Ok(LevelSweeper { study, hbm, hill, selectors: selectors(outputs) })
     }
 
     /// Sweep the band at force `level` (N), as [`run_level`].
@@ -465,7 +459,11 @@ impl<'a> LevelSweeper<'a> {
                 r.restarted_at / TWO_PI
             )
         });
-        let note = start_note.into_iter().chain(resumed_notes).chain(self.stability_note.clone()).collect::<Vec<_>>();
+        let stability_note = match (hill, &hbm) {
+            (Some(hill), Balance::Penalty(hbm)) => stability_note(hill, hbm.receptance()),
+            _ => None,
+        };
+        let note = start_note.into_iter().chain(resumed_notes).chain(stability_note).collect::<Vec<_>>();
         let note = (!note.is_empty()).then(|| note.join("; "));
         // A branch that stopped: at its last point, or where Newton last stopped beyond it.
         let singular_note = match (&branch.termination, branch.points.last(), &mut hbm) {

@@ -241,9 +241,6 @@ impl Chart {
     }
 }
 
-/// A tick label: plain decimals for moderate magnitudes, exponent form otherwise; a tick within
-/// round-off of zero on an axis of width `span` is 0 (the tick positions are computed in
-/// floating point: "-1.39e-17" appeared on slider-velocity plots).
 /// The label of the tick at `y` of a log axis from `y0` to `y1`. Where the axis holds three
 /// decade ticks or more, the decades only (1e-7, 1e-6, ...): the ticks in between (2e-7, 3e-7,
 /// ...) would crowd it. Where it holds fewer (a resonance seen over a decade or two), the
@@ -263,6 +260,9 @@ fn log_tick(y: f64, y0: f64, y1: f64) -> String {
     }
 }
 
+/// A tick label: plain decimals for moderate magnitudes, exponent form otherwise; a tick within
+/// round-off of zero on an axis of width `span` is 0 (the tick positions are computed in
+/// floating point: "-1.39e-17" appeared on slider-velocity plots).
 fn tick(v: f64, span: f64) -> String {
     let v = if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v };
     if v == 0.0 || (1e-2..1e5).contains(&v.abs()) {

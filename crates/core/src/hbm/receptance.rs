@@ -67,8 +67,9 @@ pub struct DirectReceptance {
     damping: Mat<f64>,
     /// `[V F]` (n × (q+1)).
     rhs: Mat<c64>,
-    /// The mass-normalised undamped modes, for what is written in modal coordinates (Hill's
-    /// method).
+    /// `A = Vᵀ Φ` (q × m) and the mass-normalised undamped modes, for what is written in modal
+    /// coordinates (Hill's method).
+    a: Mat<f64>,
     modes: Modes,
 }
 
@@ -147,11 +148,13 @@ impl Receptance {
     pub fn new(model: &LinearModel, directions: &[&[f64]], force: &[f64]) -> Result<Self, ModelError> {
         let n = model.n_dofs();
         let q = directions.len();
+        // The undamped modes, which also check M > 0 and K > 0 for both forms alike, and
+        // `A = Vᵀ Φ`: the modal sum's, and Hill's method's with either form.
+        let modes = model.dense_modes()?;
+        let m = modes.omega.len();
+        let phi = &modes.shapes;
+        let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
         if model.damping.is_modal() {
-            let modes = model.dense_modes()?;
-            let m = modes.omega.len();
-            let phi = &modes.shapes;
-            let a = Mat::from_fn(q, m, |i, r| (0..n).map(|l| directions[i][l] * phi[(l, r)]).sum());
             let b: Vec<f64> = (0..m).map(|r| (0..n).map(|l| force[l] * phi[(l, r)]).sum()).collect();
             let c_r =
                 modes.omega.iter().enumerate().map(|(r, &w)| model.damping.modal_coefficient(r, w).unwrap()).collect();
@@ -178,8 +181,6 @@ impl Receptance {
                 pairs,
             }))
         } else {
-            // M > 0 and K > 0 checked the same way as the modal path, so both fail alike.
-            let modes = model.dense_modes()?;
             let Damping::Matrix(d) = &model.damping else { unreachable!("non-modal damping is a matrix") };
             let rhs = Mat::from_fn(n, q + 1, |l, j| c64::new(if j < q { directions[j][l] } else { force[l] }, 0.0));
             Ok(Receptance::Direct(DirectReceptance {
@@ -187,6 +188,7 @@ impl Receptance {
                 stiffness: model.stiffness.to_dense(),
                 damping: d.to_dense(),
                 rhs,
+                a,
                 modes,
             }))
         }
@@ -514,10 +516,8 @@ impl DirectReceptance {
     }
 
     /// `A = Vᵀ Φ` (q × m): each mode seen from the nonlinear directions.
-    pub fn participation(&self) -> Mat<f64> {
-        let q = self.rhs.ncols() - 1;
-        let phi = &self.modes.shapes;
-        Mat::from_fn(q, phi.ncols(), |i, r| (0..phi.nrows()).map(|l| self.rhs[(l, i)].re * phi[(l, r)]).sum())
+    pub fn participation(&self) -> MatRef<'_, f64> {
+        self.a.as_ref()
     }
 
     fn dynamic_stiffness(&self, omega: f64) -> Mat<c64> {

@@ -21,8 +21,8 @@
 //! (`diag(c_r)`) for proportional or modal damping and full for a general damping matrix `D`
 //! (the modal equations then stay coupled through it, the eigenproblem is the same), and the
 //! joints enter through the low-rank term `K_nl = Aᵀ J A`, `A = Vᵀ Φ` (q × m) and `J = ∂G/∂x`
-//! the elements' harmonic Jacobian that Newton already uses: the quadratic problem is polynomial, of size
-//! `m(2N+1)`, and its companion form is an ordinary real eigenproblem.
+//! the elements' harmonic Jacobian that Newton already uses: the quadratic problem is
+//! polynomial, of size `m(2N+1)`, and its companion form is an ordinary real eigenproblem.
 //!
 //! **Modes kept.** The first `m` modes carry the dynamics; the modes above act quasi-statically
 //! through their residual flexibility `R = Σ_{r>m} a_r a_rᵀ / ω_r²` (a static correction), so the
@@ -133,7 +133,7 @@ impl Hill {
             Receptance::Modal(modal) => {
                 let c_r = modal.damping_coefficients();
                 let damping = Mat::from_fn(c_r.len(), c_r.len(), |r, l| if r == l { c_r[r] } else { 0.0 });
-                (modal.natural_frequencies(), damping, modal.participation().to_owned())
+                (modal.natural_frequencies(), damping, modal.participation())
             }
             Receptance::Direct(direct) => {
                 (direct.natural_frequencies(), direct.modal_damping(), direct.participation())
