@@ -395,15 +395,46 @@ impl<'m> CondensedHbm<'m> {
         // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
         // depends on its own directions only), so column (c2, off+b) of element e only meets
         // the columns off..off+d of H: O(q nc² d²) per element instead of O(q³ nc²).
-        dx.fill(0.0);
-        for i in 0..q * nc {
-            dx[(i, i)] = 1.0;
-        }
         let (h0, harmonic, sums) = (&self.h0, &self.harmonic, &mut self.product);
+        // Elements of one direction (sliders on their application vectors, the common case)
+        // write whole columns, identity included, and need no fill first: each row of their
+        // column meets one harmonic's H, so it is `(H ∂G) + δ` with the same terms as the
+        // sums of the general case below, bit for bit.
+        let single = self.model.elements.iter().all(|site| site.law.n_dirs() == 1);
+        if !single {
+            dx.fill(0.0);
+            for i in 0..q * nc {
+                dx[(i, i)] = 1.0;
+            }
+        }
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
+            if single {
+                for c2 in 0..nc {
+                    let col = c2 * q + off;
+                    let jcol = je.col_as_slice(c2);
+                    let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
+                    // `t + 0.0`: a −0 product stored as +0, as the sums from zero store it.
+                    let g = jcol[0];
+                    for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off)) {
+                        *out = h * g + 0.0;
+                    }
+                    for k in 1..=self.plan.n_harmonics() {
+                        let h = harmonic[k - 1].h.col_as_slice(off);
+                        let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+                        let (gc, gs) = (jcol[cos_index(k)], jcol[sin_index(k)]);
+                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
+                        for ((oc, os), h) in cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(h) {
+                            *oc = (h.re * gc + h.im * gs) + 0.0;
+                            *os = (-h.im * gc + h.re * gs) + 0.0;
+                        }
+                    }
+                    column[col] += 1.0;
+                }
+                continue;
+            }
             for c2 in 0..nc {
                 for b in 0..d {
                     // One column of ∂R/∂x and of the element's block, as contiguous slices
