@@ -270,6 +270,28 @@ fn frf_npz_holds_every_column_and_harmonic_exactly_in_numpy_format() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The archive's bytes depend on the results alone: its entries carry the zip format's first
+/// date (1980-01-01), not the time of the run, so two runs' files compare byte for byte.
+#[test]
+fn frf_npz_entries_are_dated_1980_so_the_same_results_make_the_same_bytes() {
+    let dir = scratch_dir("npz-dated");
+    let levels = levels(16);
+    let path = dir.join("frf.npz");
+    write_frf_npz(&path, &levels).unwrap();
+    let mut zip = npyz::zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
+    assert!(zip.len() > 10, "{} entries", zip.len());
+    for i in 0..zip.len() {
+        let entry = zip.by_index(i).unwrap();
+        let t = entry.last_modified();
+        let date = (t.year(), t.month(), t.day(), t.hour(), t.minute(), t.second());
+        assert_eq!(date, (1980, 1, 1, 0, 0, 0), "{}", entry.name());
+    }
+    drop(zip);
+    let first = std::fs::read(&path).unwrap();
+    write_frf_npz(&path, &levels).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), first);
+}
+
 #[test]
 fn an_empty_sweep_writes_an_empty_npz() {
     let dir = scratch_dir("npz-empty");

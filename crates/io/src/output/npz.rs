@@ -6,7 +6,7 @@ use std::io::{BufWriter, Write as _};
 use std::path::Path;
 
 use npyz::zip::write::FileOptions;
-use npyz::zip::{CompressionMethod, ZipWriter};
+use npyz::zip::{CompressionMethod, DateTime, ZipWriter};
 use npyz::WriterBuilder;
 
 use super::csv::{check_finite, frf_columns, frf_row, template};
@@ -46,7 +46,8 @@ pub fn write_frf_npz(path: &Path, levels: &[LevelResult]) -> Result<(), OutputEr
 
 /// A `.npz` archive being written. Its entries are stored uncompressed, as `numpy.savez`
 /// stores them: float64 results hardly compress (Table 6's `frf.npz`: 83 kB stored, 56 kB
-/// deflated), and a result file should cost the time of writing it.
+/// deflated), and a result file should cost the time of writing it. Its bytes depend on the
+/// results alone.
 pub(crate) struct NpzFile {
     zip: ZipWriter<BufWriter<File>>,
 }
@@ -71,7 +72,10 @@ impl NpzFile {
         let mut writer = npyz::WriteOptions::<T>::new().default_dtype().shape(shape).writer(&mut npy).begin_nd()?;
         writer.extend(values)?;
         writer.finish()?;
+        // Entries dated 1980-01-01, the zip format's first date, not the time of the run: the
+        // same results make the same bytes, so two runs' files compare with `cmp`.
         let options = FileOptions::default()
+            .last_modified_time(DateTime::default())
             .compression_method(CompressionMethod::Stored)
             .large_file(npy.len() >= u32::MAX as usize);
         self.zip.start_file(npyz::npz::file_name_from_array_name(name), options)?;
