@@ -395,83 +395,50 @@ impl<'m> CondensedHbm<'m> {
         // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
         // depends on its own directions only), so column (c2, off+b) of element e only meets
         // the columns off..off+d of H: O(q nc² d²) per element instead of O(q³ nc²).
-        let (h0, harmonic, sums) = (&self.h0, &self.harmonic, &mut self.product);
-        // Elements of one direction (sliders on their application vectors, the common case)
-        // write whole columns, identity included, and need no fill first: each row of their
-        // column meets one harmonic's H, so it is `(H ∂G) + δ` with the same terms as the
-        // sums of the general case below, bit for bit.
-        let single = self.model.elements.iter().all(|site| site.law.n_dirs() == 1);
-        if !single {
-            dx.fill(0.0);
-            for i in 0..q * nc {
-                dx[(i, i)] = 1.0;
-            }
-        }
+        // Every entry of a column is written (each row meets one harmonic's H), so the matrix
+        // needs no fill: the first direction's term is stored (`t + 0.0`: a −0 product as +0,
+        // as a sum from zero stores it), the others added, the identity last.
+        let (h0, harmonic) = (&self.h0, &self.harmonic);
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
-            if single {
-                for c2 in 0..nc {
-                    let col = c2 * q + off;
-                    let jcol = je.col_as_slice(c2);
-                    let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    // `t + 0.0`: a −0 product stored as +0, as the sums from zero store it.
-                    let g = jcol[0];
-                    for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off)) {
-                        *out = h * g + 0.0;
-                    }
-                    for k in 1..=self.plan.n_harmonics() {
-                        let h = harmonic[k - 1].h.col_as_slice(off);
-                        let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
-                        let (gc, gs) = (jcol[cos_index(k)], jcol[sin_index(k)]);
-                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
-                        for ((oc, os), h) in cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(h) {
-                            *oc = (h.re * gc + h.im * gs) + 0.0;
-                            *os = (-h.im * gc + h.re * gs) + 0.0;
-                        }
-                    }
-                    column[col] += 1.0;
-                }
-                continue;
-            }
             for c2 in 0..nc {
                 for b in 0..d {
                     // One column of ∂R/∂x and of the element's block, as contiguous slices
-                    // (this runs at every Newton iteration); the sums over the element's
-                    // directions `a` in `sums` (cosine part in re, sine part in im), a column of
-                    // H at a time.
+                    // (this runs at every Newton iteration), a column of H at a time.
                     let col = c2 * q + off + b;
                     let jcol = je.col_as_slice(c2 * d + b);
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    sums.fill(c64::new(0.0, 0.0));
                     for a in 0..d {
                         let g = jcol[a];
-                        for (v, h) in sums.iter_mut().zip(h0.col_as_slice(off + a)) {
-                            v.re += h * g;
+                        for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off + a)) {
+                            if a == 0 {
+                                *out = h * g + 0.0;
+                            } else {
+                                *out += h * g;
+                            }
                         }
-                    }
-                    for (out, v) in column[..q].iter_mut().zip(sums.iter()) {
-                        *out += v.re;
                     }
                     for k in 1..=self.plan.n_harmonics() {
                         let h = &harmonic[k - 1].h;
                         let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
                         let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
-                        sums.fill(c64::new(0.0, 0.0));
+                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
                         for a in 0..d {
                             let (gc, gs) = (jcol[ec + a], jcol[es + a]);
-                            for (v, h) in sums.iter_mut().zip(h.col_as_slice(off + a)) {
-                                v.re += h.re * gc + h.im * gs;
-                                v.im += -h.im * gc + h.re * gs;
+                            let rows = cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(h.col_as_slice(off + a));
+                            for ((oc, os), h) in rows {
+                                let (c, s) = (h.re * gc + h.im * gs, -h.im * gc + h.re * gs);
+                                if a == 0 {
+                                    (*oc, *os) = (c + 0.0, s + 0.0);
+                                } else {
+                                    (*oc, *os) = (*oc + c, *os + s);
+                                }
                             }
                         }
-                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
-                        for ((oc, os), v) in cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(sums.iter()) {
-                            *oc += v.re;
-                            *os += v.im;
-                        }
                     }
+                    column[col] += 1.0;
                 }
             }
         }
