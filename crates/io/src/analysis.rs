@@ -363,6 +363,13 @@ impl Problem for FrequencyProblem<'_, '_> {
             FrequencyProblem::Dlft(p) => p.complete_jacobian(jacobian),
         }
     }
+
+    fn decoupled_unknowns(&self) -> Option<&[usize]> {
+        match self {
+            FrequencyProblem::Penalty(p) => p.decoupled_unknowns(),
+            FrequencyProblem::Dlft(p) => p.decoupled_unknowns(),
+        }
+    }
 }
 
 impl<'a> LevelSweeper<'a> {

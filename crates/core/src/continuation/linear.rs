@@ -1,13 +1,15 @@
 //! The linear systems of the corrector: the bordered `(n+1)×(n+1)` system of Eq. 32 and the
 //! `n×n` system of a solve at fixed λ. Dense: factored by partial-pivot LU in place on buffers
-//! allocated once per branch (no allocation per Newton iteration). For a problem that factors
-//! its own Jacobian ([`Problem::factored`]): by block elimination of the border, two solves
-//! with `∂R/∂x`.
+//! allocated once per branch (no allocation per Newton iteration). A dense Jacobian that the
+//! problem declares block diagonal ([`Problem::decoupled_unknowns`]: the even and odd
+//! harmonics of a half-wave symmetric balance) is factored by its two blocks, the bordered
+//! system by eliminating the first block (a quarter of the flops of the whole LU for two
+//! blocks of half the size). For a problem that factors its own Jacobian
+//! ([`Problem::factored`]): by block elimination of the border, two solves with `∂R/∂x`.
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{Mat, MatMut, MatRef, Par};
+use faer::{Mat, MatRef};
 
+use super::dense_lu::PivotedLu;
 use super::singular::Determinant;
 use super::{Problem, ProblemError};
 
@@ -21,15 +23,12 @@ pub(super) struct Workspace {
     pub residual: Vec<f64>,
     /// Right-hand side, overwritten by the solution.
     pub rhs: Vec<f64>,
-    perm: Vec<usize>,
-    perm_inv: Vec<usize>,
-    /// Row transpositions of the last dense factorisation (the sign of its permutation).
-    transpositions: usize,
+    /// The row order of `matrix`'s factors.
+    pivots: PivotedLu,
     /// Dense: `matrix` holds the Jacobian of the last evaluation, not yet factored.
     holds_jacobian: bool,
     /// Dense: `matrix` holds the LU factors of the last bordered system solved.
     holds_bordered_factors: bool,
-    scratch: MemBuffer,
     /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
     factored: bool,
     /// Dense, and the problem completes a residual evaluation to its Jacobian
@@ -39,6 +38,171 @@ pub(super) struct Workspace {
     singular: bool,
     /// Factored: `(∂R/∂x)⁻¹ ∂R/∂λ` for the border.
     border: Vec<f64>,
+    /// Dense, the last Jacobian block diagonal: its blocks, and their factors once solved.
+    split: Option<Split>,
+    /// `split` holds the blocks of the last Jacobian evaluated.
+    split_active: bool,
+    /// The last factorisation was of `split`'s blocks.
+    factors_split: bool,
+    /// `∂R/∂λ` scaled for the border of a split system.
+    border_scaled: Vec<f64>,
+}
+
+/// A square matrix and its partial-pivot LU factors, in place.
+struct Lu {
+    matrix: Mat<f64>,
+    pivots: PivotedLu,
+}
+
+impl Lu {
+    fn new(size: usize) -> Self {
+        Lu { matrix: Mat::zeros(size, size), pivots: PivotedLu::new(size) }
+    }
+
+    /// Factor `matrix`.
+    fn factor(&mut self) {
+        self.pivots.factor(self.matrix.as_ref());
+    }
+
+    /// Overwrite `rhs` with the solution, by the factors.
+    fn solve(&mut self, rhs: &mut [f64]) {
+        self.pivots.solve(rhs);
+    }
+
+    fn determinant(&self) -> Determinant {
+        self.pivots.determinant()
+    }
+}
+
+/// A block-diagonal Jacobian `diag(J_a, J_b)` (unknowns `a` and `b`, each ascending) and its
+/// factors. The bordered system `[c_x J  c_λ r; tᵀ t_λ]` is solved by eliminating the first
+/// block: with `w = (c_x J_a)⁻¹ c_λ r_a`, the second block bordered by the Schur complement,
+/// `S = [c_x J_b  c_λ r_b; t_bᵀ  t_λ − t_aᵀ w]`, and `det B = det(c_x J_a) det S` (the blocks
+/// are a symmetric permutation of `B`, which keeps its determinant). The first block is the
+/// one away from the branch's folds (the even harmonics of a symmetric response, which it
+/// does not move): `J_b`, singular at a fold, is never inverted alone there.
+struct Split {
+    a: Vec<usize>,
+    b: Vec<usize>,
+    /// `c_x J_a`, factored.
+    first: Lu,
+    /// `S` of the bordered system (size `|b| + 1`), or `c_x J_b` at fixed λ (size `|b|`),
+    /// factored.
+    second: Lu,
+    /// `c_x J_b` for a solve at fixed λ.
+    second_fixed: Lu,
+    /// `w` and `t_a` of the last bordered system.
+    w: Vec<f64>,
+    t_a: Vec<f64>,
+    /// Gathered right-hand sides.
+    rhs_a: Vec<f64>,
+    rhs_b: Vec<f64>,
+}
+
+impl Split {
+    fn new(a: &[usize], n: usize) -> Self {
+        let b: Vec<usize> = (0..n).filter(|i| a.binary_search(i).is_err()).collect();
+        let (na, nb) = (a.len(), b.len());
+        Split {
+            first: Lu::new(na),
+            second: Lu::new(nb + 1),
+            second_fixed: Lu::new(nb),
+            w: vec![0.0; na],
+            t_a: vec![0.0; na],
+            rhs_a: vec![0.0; na],
+            rhs_b: vec![0.0; nb + 1],
+            a: a.to_vec(),
+            b,
+        }
+    }
+
+    /// Factor the blocks of `c_x J` (in `jacobian`, n × n) for the bordered system with
+    /// column `c_λ r` and row `t`.
+    fn factor_bordered(&mut self, jacobian: MatRef<'_, f64>, cx: f64, border: &[f64], t: &[f64]) {
+        let nb = self.b.len();
+        gather(&mut self.first.matrix, jacobian, &self.a, cx);
+        self.first.factor();
+        for (k, &i) in self.a.iter().enumerate() {
+            self.w[k] = border[i];
+            self.t_a[k] = t[i];
+        }
+        self.first.solve(&mut self.w);
+        let s = &mut self.second.matrix;
+        for (l, &j) in self.b.iter().enumerate() {
+            for (k, &i) in self.b.iter().enumerate() {
+                s[(k, l)] = jacobian[(i, j)] * cx;
+            }
+            s[(nb, l)] = t[j];
+        }
+        for (k, &i) in self.b.iter().enumerate() {
+            s[(k, nb)] = border[i];
+        }
+        let t_w: f64 = self.t_a.iter().zip(&self.w).map(|(a, b)| a * b).sum();
+        s[(nb, nb)] = t[t.len() - 1] - t_w;
+        self.second.factor();
+    }
+
+    /// Solve the bordered system factored by [`Self::factor_bordered`] for `rhs` (n + 1), in
+    /// place.
+    fn solve_bordered(&mut self, rhs: &mut [f64]) {
+        let nb = self.b.len();
+        for (k, &i) in self.a.iter().enumerate() {
+            self.rhs_a[k] = rhs[i];
+        }
+        self.first.solve(&mut self.rhs_a);
+        for (k, &i) in self.b.iter().enumerate() {
+            self.rhs_b[k] = rhs[i];
+        }
+        let t_y: f64 = self.t_a.iter().zip(&self.rhs_a).map(|(a, b)| a * b).sum();
+        self.rhs_b[nb] = rhs[rhs.len() - 1] - t_y;
+        self.second.solve(&mut self.rhs_b);
+        let alpha = self.rhs_b[nb];
+        for (k, &i) in self.a.iter().enumerate() {
+            rhs[i] = self.rhs_a[k] - alpha * self.w[k];
+        }
+        for (k, &i) in self.b.iter().enumerate() {
+            rhs[i] = self.rhs_b[k];
+        }
+        rhs[rhs.len() - 1] = alpha;
+    }
+
+    /// Factor and solve `c_x J Δu = rhs` (n), in place.
+    fn solve_fixed(&mut self, jacobian: MatRef<'_, f64>, cx: f64, rhs: &mut [f64]) {
+        gather(&mut self.first.matrix, jacobian, &self.a, cx);
+        self.first.factor();
+        gather(&mut self.second_fixed.matrix, jacobian, &self.b, cx);
+        self.second_fixed.factor();
+        for (k, &i) in self.a.iter().enumerate() {
+            self.rhs_a[k] = rhs[i];
+        }
+        self.first.solve(&mut self.rhs_a);
+        let nb = self.b.len();
+        for (k, &i) in self.b.iter().enumerate() {
+            self.rhs_b[k] = rhs[i];
+        }
+        self.second_fixed.solve(&mut self.rhs_b[..nb]);
+        for (k, &i) in self.a.iter().enumerate() {
+            rhs[i] = self.rhs_a[k];
+        }
+        for (k, &i) in self.b.iter().enumerate() {
+            rhs[i] = self.rhs_b[k];
+        }
+    }
+
+    fn bordered_determinant(&self) -> Determinant {
+        let (a, s) = (self.first.determinant(), self.second.determinant());
+        Determinant { sign: a.sign * s.sign, ln_abs: a.ln_abs + s.ln_abs }
+    }
+}
+
+/// `block = c_x jacobian[rows, rows]`.
+fn gather(block: &mut Mat<f64>, jacobian: MatRef<'_, f64>, rows: &[usize], cx: f64) {
+    for (l, &j) in rows.iter().enumerate() {
+        let column = jacobian.col(j);
+        for (k, &i) in rows.iter().enumerate() {
+            block[(k, l)] = column[i] * cx;
+        }
+    }
 }
 
 impl Workspace {
@@ -47,11 +211,6 @@ impl Workspace {
         let n = problem.dimension();
         let factored = problem.factored().is_some();
         let size = if factored { 0 } else { n + 1 };
-        let par = Par::Seq;
-        let req = StackReq::any_of(&[
-            factor::lu_in_place_scratch::<usize, f64>(size, size, par, Default::default()),
-            solve::solve_in_place_scratch::<usize, f64>(size, 1, par),
-        ]);
         Workspace {
             n,
             matrix: Mat::zeros(size, size),
@@ -62,13 +221,27 @@ impl Workspace {
             dr_dlambda: vec![0.0; n],
             residual: vec![0.0; n],
             rhs: vec![0.0; n + 1],
-            perm: vec![0; n + 1],
-            perm_inv: vec![0; n + 1],
-            transpositions: 0,
+            pivots: PivotedLu::new(size),
             holds_jacobian: false,
             holds_bordered_factors: false,
-            scratch: MemBuffer::new(req),
+            split: None,
+            split_active: false,
+            factors_split: false,
+            border_scaled: vec![0.0; n],
         }
+    }
+
+    /// After the problem wrote a dense Jacobian: is it block diagonal, and in which blocks?
+    fn note_blocks<P: Problem + ?Sized>(&mut self, problem: &P) {
+        self.split_active = match problem.decoupled_unknowns() {
+            Some(a) if !a.is_empty() && a.len() < self.n => {
+                if self.split.as_ref().is_none_or(|split| split.a != a) {
+                    self.split = Some(Split::new(a, self.n));
+                }
+                true
+            }
+            _ => false,
+        };
     }
 
     /// Evaluate `problem` at `(x, λ)`: the residual into `self.residual` and, with
@@ -95,6 +268,7 @@ impl Workspace {
         jx.fill(0.0);
         self.holds_bordered_factors = false;
         problem.evaluate(x, lambda, &mut self.residual, Some((jx, &mut self.dr_dlambda)))?;
+        self.note_blocks(problem);
         self.holds_jacobian = true;
         Ok(())
     }
@@ -125,6 +299,7 @@ impl Workspace {
         self.holds_jacobian = false;
         self.holds_bordered_factors = false;
         problem.complete_jacobian((jx, &mut self.dr_dlambda))?;
+        self.note_blocks(problem);
         self.holds_jacobian = true;
         Ok(())
     }
@@ -166,6 +341,16 @@ impl Workspace {
             self.rhs[n] = alpha;
             return self.rhs.iter().all(|v| v.is_finite());
         }
+        if let Some(split) = self.split.as_mut().filter(|_| self.split_active) {
+            self.border_scaled.iter_mut().zip(&self.dr_dlambda).for_each(|(b, r)| *b = r * cl);
+            let jacobian = self.matrix.as_ref().submatrix(0, 0, n, n);
+            split.factor_bordered(jacobian, cx, &self.border_scaled, t);
+            split.solve_bordered(&mut self.rhs);
+            self.holds_jacobian = false;
+            self.holds_bordered_factors = true;
+            self.factors_split = true;
+            return self.rhs.iter().all(|v| v.is_finite());
+        }
         for j in 0..n {
             // A contiguous column at a time (this scales every Jacobian the corrector solves).
             let column = self.matrix.col_as_slice_mut(j);
@@ -179,6 +364,7 @@ impl Workspace {
         }
         let solved = self.factor_and_solve(n + 1);
         self.holds_bordered_factors = true;
+        self.factors_split = false;
         solved
     }
 
@@ -191,11 +377,12 @@ impl Workspace {
     /// Solve `rhs` again with the factors of the last bordered system (only when
     /// [`Self::holds_bordered_factors`]), in place. False if the solution is not finite.
     pub fn solve_with_bordered_factors(&mut self) -> bool {
+        if let Some(split) = self.split.as_mut().filter(|_| self.factors_split) {
+            split.solve_bordered(&mut self.rhs);
+            return self.rhs.iter().all(|v| v.is_finite());
+        }
         let size = self.n + 1;
-        let lu = self.matrix.as_ref();
-        let perm = faer::perm::PermRef::new_checked(&self.perm[..size], &self.perm_inv[..size], size);
-        let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs[..size], size, 1);
-        solve::solve_in_place(lu, lu, perm, rhs, Par::Seq, MemStack::new(&mut self.scratch));
+        self.pivots.solve(&mut self.rhs[..size]);
         self.rhs.iter().all(|v| v.is_finite())
     }
 
@@ -209,6 +396,13 @@ impl Workspace {
                 return false;
             }
             self.rhs[..n].iter_mut().for_each(|v| *v /= cx);
+            return self.rhs[..n].iter().all(|v| v.is_finite());
+        }
+        if let Some(split) = self.split.as_mut().filter(|_| self.split_active) {
+            let jacobian = self.matrix.as_ref().submatrix(0, 0, n, n);
+            split.solve_fixed(jacobian, cx, &mut self.rhs[..n]);
+            self.holds_jacobian = false;
+            self.holds_bordered_factors = false;
             return self.rhs[..n].iter().all(|v| v.is_finite());
         }
         for j in 0..n {
@@ -227,33 +421,113 @@ impl Workspace {
         if self.factored {
             return None;
         }
-        let mut determinant = Determinant { sign: if self.transpositions & 1 == 0 { 1.0 } else { -1.0 }, ln_abs: 0.0 };
-        for i in 0..=self.n {
-            let pivot = self.matrix[(i, i)];
-            determinant.sign *= if pivot == 0.0 { 0.0 } else { pivot.signum() };
-            determinant.ln_abs += pivot.abs().ln();
+        if let Some(split) = self.split.as_ref().filter(|_| self.factors_split) {
+            return Some(split.bordered_determinant());
         }
-        Some(determinant)
+        Some(self.pivots.determinant())
     }
 
     fn factor_and_solve(&mut self, size: usize) -> bool {
         self.holds_jacobian = false;
         self.holds_bordered_factors = false;
-        let par = Par::Seq;
-        let mut a = self.matrix.as_mut().submatrix_mut(0, 0, size, size);
-        let stack = MemStack::new(&mut self.scratch);
-        let (info, perm) = factor::lu_in_place(
-            a.as_mut(),
-            &mut self.perm[..size],
-            &mut self.perm_inv[..size],
-            par,
-            stack,
-            Default::default(),
-        );
-        self.transpositions = info.transposition_count;
-        let lu = a.as_ref();
-        let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs[..size], size, 1);
-        solve::solve_in_place(lu, lu, perm, rhs, par, MemStack::new(&mut self.scratch));
+        self.pivots.factor(self.matrix.as_ref().submatrix(0, 0, size, size));
+        self.pivots.solve(&mut self.rhs[..size]);
         self.rhs[..size].iter().all(|v| v.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::MatMut;
+
+    /// `R(x, λ) = J x − λ c` with a Jacobian block diagonal in the unknowns {0, 2, 3} and
+    /// {1, 4}, declared as such or not.
+    struct Blocks {
+        declare: bool,
+    }
+
+    const A: [usize; 3] = [0, 2, 3];
+
+    fn jacobian(i: usize, j: usize) -> f64 {
+        let same = A.contains(&i) == A.contains(&j);
+        if !same {
+            0.0
+        } else if i == j {
+            3.0 + i as f64
+        } else {
+            ((i * 7 + j * 3) % 5) as f64 * 0.4 - 0.8
+        }
+    }
+
+    impl Problem for Blocks {
+        fn dimension(&self) -> usize {
+            5
+        }
+
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            lambda: f64,
+            residual: &mut [f64],
+            jacobian_out: Option<(MatMut<'_, f64>, &mut [f64])>,
+        ) -> Result<(), ProblemError> {
+            let c = [1.0, -2.0, 0.5, 0.25, 3.0];
+            for i in 0..5 {
+                residual[i] = (0..5).map(|j| jacobian(i, j) * x[j]).sum::<f64>() - lambda * c[i];
+            }
+            if let Some((mut dx, dl)) = jacobian_out {
+                for i in 0..5 {
+                    for j in 0..5 {
+                        dx[(i, j)] = jacobian(i, j);
+                    }
+                    dl[i] = -c[i];
+                }
+            }
+            Ok(())
+        }
+
+        fn decoupled_unknowns(&self) -> Option<&[usize]> {
+            self.declare.then_some(&A[..])
+        }
+    }
+
+    /// The bordered system and a solve at fixed λ give the same solution (to 1e-14 of it) and
+    /// the same bordered determinant (to 1e-13 in its logarithm, and its sign) whether the
+    /// Jacobian's two blocks are factored apart or the whole matrix is; so does a second
+    /// right-hand side solved with the factors kept.
+    #[test]
+    fn split_blocks_solve_as_the_whole_matrix() {
+        let t = [0.3, -0.1, 0.7, 0.2, -0.5, 0.6];
+        let rhs = [1.0, 2.0, -1.0, 0.5, 0.25, -0.75];
+        let mut results = Vec::new();
+        for declare in [false, true] {
+            let mut problem = Blocks { declare };
+            let mut ws = Workspace::new(&mut problem);
+            ws.evaluate(&mut problem, &[0.1, 0.2, 0.3, 0.4, 0.5], 1.5, true).unwrap();
+            assert_eq!(ws.split_active, declare);
+            ws.rhs.copy_from_slice(&rhs);
+            assert!(ws.solve_bordered(&mut problem, 2.0, 0.5, 4.0, &t));
+            let bordered = ws.rhs.clone();
+            let determinant = ws.bordered_determinant().unwrap();
+            ws.rhs.copy_from_slice(&t);
+            assert!(ws.solve_with_bordered_factors());
+            let again = ws.rhs.clone();
+            ws.evaluate(&mut problem, &[0.1, 0.2, 0.3, 0.4, 0.5], 1.5, true).unwrap();
+            ws.rhs[..5].copy_from_slice(&rhs[..5]);
+            assert!(ws.solve_fixed(&mut problem, 2.0, 4.0));
+            let fixed = ws.rhs[..5].to_vec();
+            results.push((bordered, determinant, again, fixed));
+        }
+        let (whole, split) = (&results[0], &results[1]);
+        let close = |a: &[f64], b: &[f64]| {
+            let scale = a.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-14 * scale)
+        };
+        assert!(close(&whole.0, &split.0), "{:?} against {:?}", whole.0, split.0);
+        assert!(close(&whole.2, &split.2), "{:?} against {:?}", whole.2, split.2);
+        assert!(close(&whole.3, &split.3), "{:?} against {:?}", whole.3, split.3);
+        assert_eq!(whole.1.sign, split.1.sign);
+        assert!((whole.1.ln_abs - split.1.ln_abs).abs() <= 1e-13, "{:?} against {:?}", whole.1, split.1);
     }
 }

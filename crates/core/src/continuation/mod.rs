@@ -115,6 +115,7 @@
 //! # Ok::<(), stickslip_core::continuation::ContinuationError>(())
 //! ```
 
+mod dense_lu;
 mod extremum;
 mod linear;
 mod run;
@@ -170,6 +171,15 @@ pub trait Problem {
     /// [`Self::completes_jacobian`].
     fn complete_jacobian(&mut self, _jacobian: (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
         Err(ProblemError::new("this problem does not complete a residual evaluation to a Jacobian"))
+    }
+
+    /// `Some(a)` when the last dense `∂R/∂x` written ([`Self::evaluate`] or
+    /// [`Self::complete_jacobian`]) is block diagonal: zero between the unknowns `a`
+    /// (ascending) and the others. The corrector then factors the two blocks apart (the even
+    /// and odd harmonics of a half-wave symmetric balance). `a` should be the block that stays
+    /// regular at the branch's folds. Default: `None` (one dense block).
+    fn decoupled_unknowns(&self) -> Option<&[usize]> {
+        None
     }
 }
 

@@ -100,6 +100,13 @@ pub struct CondensedHbm<'m> {
     /// evaluation's: [`Self::evaluated_at`]).
     last: Option<(f64, f64)>,
     last_x: Vec<f64>,
+    /// The unknowns of the even harmonics (0, 2, 4, ...), ascending.
+    even_unknowns: Vec<usize>,
+    /// The last dense `∂R/∂x` assembled couples no even harmonic with an odd one
+    /// ([`Self::decoupled_unknowns`]).
+    parity_split: bool,
+    /// Offer the split where it holds (default; [`Self::without_parity_split`]).
+    splits_parity: bool,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -163,6 +170,12 @@ impl<'m> CondensedHbm<'m> {
             }),
             last: None,
             last_x: vec![0.0; q * plan.n_coeffs()],
+            even_unknowns: (0..plan.n_coeffs())
+                .filter(|&c| coefficient_is_even(c))
+                .flat_map(|c| c * q..(c + 1) * q)
+                .collect(),
+            parity_split: false,
+            splits_parity: true,
             plan,
             evaluations: 0,
         }
@@ -390,39 +403,78 @@ impl<'m> CondensedHbm<'m> {
         self.factored.as_ref()
     }
 
+    /// The unknowns of the even harmonics when the last dense `∂R/∂x` assembled is zero
+    /// between them and the odd ones (a half-wave symmetric response, `x(t + T/2) = −x(t)`:
+    /// sliders, cubic springs driven at the fundamental), for the corrector to factor the two
+    /// blocks apart (`continuation::Problem::decoupled_unknowns`). The even block is the one
+    /// that stays regular at the folds of a symmetric branch (which move the odd harmonics).
+    pub fn decoupled_unknowns(&self) -> Option<&[usize]> {
+        self.parity_split.then_some(self.even_unknowns.as_slice())
+    }
+
+    /// The balance with its dense `∂R/∂x` always written whole, the parities coupled by their
+    /// round-off: the reference the split is tested against.
+    pub fn without_parity_split(mut self) -> Self {
+        self.splits_parity = false;
+        self
+    }
+
     fn assemble_jacobian(&mut self, mut dx: MatMut<'_, f64>, nc: usize) {
         let q = self.q;
+        // A response with half-wave symmetry has joints' Jacobians that couple harmonics of
+        // one parity only (∂g/∂x(t) is T/2-periodic); the AFT leaves round-off between
+        // parities. Where every element's coupling between parities is below
+        // `PARITY_COUPLING` of its largest term, it is left out (a change of the Newton
+        // matrix by less than that, which moves no converged point beyond round-off) and the
+        // matrix is block diagonal in the even and odd harmonics.
+        self.parity_split = self.splits_parity
+            && q * nc >= SPLIT_FROM
+            && self.model.elements.iter().enumerate().all(|(e, site)| {
+                let stiffness = site.law.slider_stiffness().unwrap_or(0.0);
+                parity_coupling_negligible(&self.joints.elem_jac[e], site.law.n_dirs(), stiffness)
+            });
+        let split = self.parity_split;
         // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
         // depends on its own directions only), so column (c2, off+b) of element e only meets
         // the columns off..off+d of H: O(q nc² d²) per element instead of O(q³ nc²).
         // Every entry of a column is written (each row meets one harmonic's H), so the matrix
         // needs no fill: the first direction's term is stored (`t + 0.0`: a −0 product as +0,
-        // as a sum from zero stores it), the others added, the identity last.
+        // as a sum from zero stores it), the others added, the identity last; split, the rows
+        // of the other parity are zero.
         let (h0, harmonic) = (&self.h0, &self.harmonic);
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
+                let even_column = coefficient_is_even(c2);
                 for b in 0..d {
                     // One column of ∂R/∂x and of the element's block, as contiguous slices
                     // (this runs at every Newton iteration), a column of H at a time.
                     let col = c2 * q + off + b;
                     let jcol = je.col_as_slice(c2 * d + b);
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    for a in 0..d {
-                        let g = jcol[a];
-                        for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off + a)) {
-                            if a == 0 {
-                                *out = h * g + 0.0;
-                            } else {
-                                *out += h * g;
+                    if split && !even_column {
+                        column[..q].fill(0.0);
+                    } else {
+                        for a in 0..d {
+                            let g = jcol[a];
+                            for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off + a)) {
+                                if a == 0 {
+                                    *out = h * g + 0.0;
+                                } else {
+                                    *out += h * g;
+                                }
                             }
                         }
                     }
                     for k in 1..=self.plan.n_harmonics() {
-                        let h = &harmonic[k - 1].h;
                         let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+                        if split && (k % 2 == 0) != even_column {
+                            column[ic..is + q].fill(0.0);
+                            continue;
+                        }
+                        let h = &harmonic[k - 1].h;
                         let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
                         let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
                         for a in 0..d {
@@ -636,4 +688,40 @@ fn multiply(h: &Mat<c64>, g: &[c64], out: &mut [c64]) {
 /// vector of width `width`.
 pub fn complex_amplitude(x: &[f64], width: usize, k: usize, i: usize) -> c64 {
     c64::new(x[cos_index(k) * width + i], -x[sin_index(k) * width + i])
+}
+
+/// Coupling between harmonics of opposite parity in an element's Jacobian below this,
+/// relative to its largest term, counts as none (the AFT of a half-wave symmetric motion
+/// leaves ~1e-16 there; an unsymmetric stick pattern, at least one sample in n_t).
+const PARITY_COUPLING: f64 = 1e-12;
+
+/// The Jacobian is offered split by parity from this many unknowns. Below, the check, the two
+/// factorisations, their gathers and the elimination of the border cost more than the flops
+/// they save: counted on whole runs (instructions), Table 6 (15 unknowns) took 2 % more split
+/// and the 10-DOF chain with 4 sliders (60 unknowns) 8 % less.
+const SPLIT_FROM: usize = 32;
+
+/// Is the harmonic of Fourier coefficient `c` (0; cos 1, sin 1; cos 2, ...) even?
+fn coefficient_is_even(c: usize) -> bool {
+    c.div_ceil(2).is_multiple_of(2)
+}
+
+/// Does an element's Jacobian (`(nc d) × (nc d)`, coefficient-major) couple harmonics of
+/// opposite parity by no more than [`PARITY_COUPLING`] of its largest term or of its
+/// `stiffness`, whichever is larger? (A stuck slider that replaces the stiffness of its joint
+/// has a Jacobian of round-off alone: `k s_j − k_r = 0`.)
+fn parity_coupling_negligible(jacobian: &Mat<f64>, d: usize, stiffness: f64) -> bool {
+    let size = jacobian.ncols();
+    let (mut largest, mut across) = (0.0_f64, 0.0_f64);
+    // Per column, the largest term and the largest of the other parity's rows (through a 0/1
+    // weight: one pass without branches, which the compiler vectorises).
+    let odd_rows = |i: usize| if coefficient_is_even(i / d) { 0.0_f64 } else { 1.0 };
+    for j in 0..size {
+        let flip = if coefficient_is_even(j / d) { 0.0_f64 } else { 1.0 };
+        for (i, v) in jacobian.col_as_slice(j).iter().enumerate() {
+            largest = largest.max(v.abs());
+            across = across.max(v.abs() * (odd_rows(i) - flip).abs());
+        }
+    }
+    across <= PARITY_COUPLING * largest.max(stiffness)
 }

@@ -58,6 +58,10 @@ impl Problem for FrequencySweep<'_, '_> {
         completed(self.hbm.complete_jacobian(dx, Some(dl), None))
     }
 
+    fn decoupled_unknowns(&self) -> Option<&[usize]> {
+        self.hbm.decoupled_unknowns()
+    }
+
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
         if self.hbm.factors_by_structure() {
             Some(self)
@@ -105,6 +109,10 @@ impl Problem for LevelSweep<'_, '_> {
 
     fn complete_jacobian(&mut self, (dx, dl): (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
         completed(self.hbm.complete_jacobian(dx, None, Some(dl)))
+    }
+
+    fn decoupled_unknowns(&self) -> Option<&[usize]> {
+        self.hbm.decoupled_unknowns()
     }
 
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
