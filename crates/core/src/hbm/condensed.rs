@@ -102,6 +102,9 @@ pub struct CondensedHbm<'m> {
     last_x: Vec<f64>,
     /// The unknowns of the even harmonics (0, 2, 4, ...), ascending.
     even_unknowns: Vec<usize>,
+    /// Per element, the rows of its Jacobian of the other parity than an even column's
+    /// (`[0]`) and an odd column's (`[1]`), as 1 (0 elsewhere).
+    parity_masks: Vec<[Vec<f64>; 2]>,
     /// The last dense `∂R/∂x` assembled couples no even harmonic with an odd one
     /// ([`Self::decoupled_unknowns`]).
     parity_split: bool,
@@ -176,6 +179,17 @@ impl<'m> CondensedHbm<'m> {
                 .collect(),
             parity_split: false,
             splits_parity: true,
+            parity_masks: model
+                .elements
+                .iter()
+                .map(|site| {
+                    let d = site.law.n_dirs();
+                    let odd: Vec<f64> =
+                        (0..plan.n_coeffs() * d).map(|i| if coefficient_is_even(i / d) { 0.0 } else { 1.0 }).collect();
+                    let even = odd.iter().map(|w| 1.0 - w).collect();
+                    [odd, even]
+                })
+                .collect(),
             plan,
             evaluations: 0,
         }
@@ -431,7 +445,12 @@ impl<'m> CondensedHbm<'m> {
             && q * nc >= SPLIT_FROM
             && self.model.elements.iter().enumerate().all(|(e, site)| {
                 let stiffness = site.law.slider_stiffness().unwrap_or(0.0);
-                parity_coupling_negligible(&self.joints.elem_jac[e], site.law.n_dirs(), stiffness)
+                parity_coupling_negligible(
+                    &self.joints.elem_jac[e],
+                    site.law.n_dirs(),
+                    &self.parity_masks[e],
+                    stiffness,
+                )
             });
         let split = self.parity_split;
         // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
@@ -710,17 +729,15 @@ fn coefficient_is_even(c: usize) -> bool {
 /// opposite parity by no more than [`PARITY_COUPLING`] of its largest term or of its
 /// `stiffness`, whichever is larger? (A stuck slider that replaces the stiffness of its joint
 /// has a Jacobian of round-off alone: `k s_j − k_r = 0`.)
-fn parity_coupling_negligible(jacobian: &Mat<f64>, d: usize, stiffness: f64) -> bool {
-    let size = jacobian.ncols();
+fn parity_coupling_negligible(jacobian: &Mat<f64>, d: usize, masks: &[Vec<f64>; 2], stiffness: f64) -> bool {
     let (mut largest, mut across) = (0.0_f64, 0.0_f64);
-    // Per column, the largest term and the largest of the other parity's rows (through a 0/1
-    // weight: one pass without branches, which the compiler vectorises).
-    let odd_rows = |i: usize| if coefficient_is_even(i / d) { 0.0_f64 } else { 1.0 };
-    for j in 0..size {
-        let flip = if coefficient_is_even(j / d) { 0.0_f64 } else { 1.0 };
-        for (i, v) in jacobian.col_as_slice(j).iter().enumerate() {
+    // Per column, the largest term and the largest of the other parity's rows (through the
+    // 0/1 mask: one pass without branches, which the compiler vectorises).
+    for j in 0..jacobian.ncols() {
+        let mask = &masks[usize::from(!coefficient_is_even(j / d))];
+        for (v, m) in jacobian.col_as_slice(j).iter().zip(mask) {
             largest = largest.max(v.abs());
-            across = across.max(v.abs() * (odd_rows(i) - flip).abs());
+            across = across.max(v.abs() * m);
         }
     }
     across <= PARITY_COUPLING * largest.max(stiffness)
