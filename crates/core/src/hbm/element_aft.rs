@@ -408,20 +408,24 @@ impl ElementAft {
         let n = nc / 2;
         let scale = |c: usize| if c == 0 { 1.0 } else { 2.0 } / nt as f64;
         for b in 0..=n {
-            // The columns of harmonic b: cos (c' = 2b − 1, or 0) and sin (c' = 2b).
-            let (cos_col, sin_col) = if b == 0 { (0, None) } else { (2 * b - 1, Some(2 * b)) };
+            // The columns of harmonic b: cos (c' = 2b − 1, or 0) and sin (c' = 2b, the next),
+            // as contiguous slices (this runs at every Jacobian of every slider).
+            let cos_col = if b == 0 { 0 } else { 2 * b - 1 };
+            let (left, right) = jac.as_mut().split_at_col_mut(cos_col + 1);
+            let cos_column = column_slice(left, cos_col);
+            let mut sin_column = (b > 0).then(|| column_slice(right, 0));
             for a in 0..=n {
                 let (d, s) = ((a as isize) - (b as isize), (a + b) as isize);
                 let (cos_row, sin_row) = if a == 0 { (0, None) } else { (2 * a - 1, Some(2 * a)) };
                 let (wc_d, wc_s, ws_d, ws_s) = (wc(d), wc(s), ws(d), ws(s));
-                jac[(cos_row, cos_col)] = scale(cos_row) * (0.5 * (wc_d + wc_s));
+                cos_column[cos_row] = scale(cos_row) * (0.5 * (wc_d + wc_s));
                 if let Some(sin_row) = sin_row {
-                    jac[(sin_row, cos_col)] = scale(sin_row) * (0.5 * (ws_s + ws_d));
+                    cos_column[sin_row] = scale(sin_row) * (0.5 * (ws_s + ws_d));
                 }
-                if let Some(sin_col) = sin_col {
-                    jac[(cos_row, sin_col)] = scale(cos_row) * (0.5 * (ws_s - ws_d));
+                if let Some(sin_column) = sin_column.as_deref_mut() {
+                    sin_column[cos_row] = scale(cos_row) * (0.5 * (ws_s - ws_d));
                     if let Some(sin_row) = sin_row {
-                        jac[(sin_row, sin_col)] = scale(sin_row) * (0.5 * (wc_d - wc_s));
+                        sin_column[sin_row] = scale(sin_row) * (0.5 * (wc_d - wc_s));
                     }
                 }
             }
@@ -627,6 +631,11 @@ fn accumulate_basis(target: &mut [f64], d: usize, b: usize, alpha: f64, beta: f6
             target[c * d + b] += alpha * ec + beta * dec;
         }
     }
+}
+
+/// Column `j` of a column-major matrix, as a slice.
+fn column_slice(m: MatMut<'_, f64>, j: usize) -> &mut [f64] {
+    m.col_mut(j).try_as_col_major_mut().expect("column-major").as_slice_mut()
 }
 
 #[cfg(test)]
