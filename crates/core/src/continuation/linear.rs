@@ -1,5 +1,5 @@
 //! The linear systems of the corrector: the bordered `(n+1)×(n+1)` system of Eq. 32 and the
-//! `n×n` system of a solve at fixed λ. Dense: factored by partial-pivot LU in place on buffers
+//! `n×n` system of a solve at fixed λ. Dense: factored by partial-pivot LU (`dense_lu`) on buffers
 //! allocated once per branch (no allocation per Newton iteration). A dense Jacobian that the
 //! problem declares block diagonal ([`Problem::decoupled_unknowns`]: the even and odd
 //! harmonics of a half-wave symmetric balance) is factored by its two blocks, the bordered
@@ -16,7 +16,7 @@ use super::{Problem, ProblemError};
 /// Workspace for the corrector: Jacobian buffers, LU factors and right-hand side.
 pub(super) struct Workspace {
     n: usize,
-    /// Column-major `(n+1)×(n+1)`: `[∂R/∂x ∂R/∂λ; tᵀ]`, factored in place.
+    /// Column-major `(n+1)×(n+1)`: `[∂R/∂x ∂R/∂λ; tᵀ]`, scaled, then factored into `pivots`.
     matrix: Mat<f64>,
     /// ∂R/∂λ as the problem writes it.
     pub dr_dlambda: Vec<f64>,
@@ -27,7 +27,7 @@ pub(super) struct Workspace {
     pivots: PivotedLu,
     /// Dense: `matrix` holds the Jacobian of the last evaluation, not yet factored.
     holds_jacobian: bool,
-    /// Dense: `matrix` holds the LU factors of the last bordered system solved.
+    /// Dense: `pivots` (or `split`) holds the LU factors of the last bordered system solved.
     holds_bordered_factors: bool,
     /// The problem factors `∂R/∂x` itself (`matrix` is then empty).
     factored: bool,
@@ -48,7 +48,7 @@ pub(super) struct Workspace {
     border_scaled: Vec<f64>,
 }
 
-/// A square matrix and its partial-pivot LU factors, in place.
+/// A square matrix and its partial-pivot LU factors.
 struct Lu {
     matrix: Mat<f64>,
     pivots: PivotedLu,
@@ -86,8 +86,7 @@ struct Split {
     b: Vec<usize>,
     /// `c_x J_a`, factored.
     first: Lu,
-    /// `S` of the bordered system (size `|b| + 1`), or `c_x J_b` at fixed λ (size `|b|`),
-    /// factored.
+    /// `S` of the bordered system (size `|b| + 1`), factored.
     second: Lu,
     /// `c_x J_b` for a solve at fixed λ.
     second_fixed: Lu,
@@ -306,7 +305,7 @@ impl Workspace {
 
     /// Solve the bordered system of Eq. 32 in scaled variables,
     /// `[∂R/∂x·s_x/s_R  ∂R/∂λ·s_λ/s_R; tᵀ] Δz = rhs`, with the Jacobian of the last
-    /// evaluation. A dense factorisation destroys the Jacobian. Returns false when the
+    /// evaluation. A dense solve scales the Jacobian in place (it is not held after). Returns false when the
     /// solution is not finite (singular bordered matrix).
     pub fn solve_bordered<P: Problem + ?Sized>(
         &mut self,
