@@ -305,8 +305,8 @@ impl Workspace {
 
     /// Solve the bordered system of Eq. 32 in scaled variables,
     /// `[∂R/∂x·s_x/s_R  ∂R/∂λ·s_λ/s_R; tᵀ] Δz = rhs`, with the Jacobian of the last
-    /// evaluation. A dense solve scales the Jacobian in place (it is not held after). Returns false when the
-    /// solution is not finite (singular bordered matrix).
+    /// evaluation. A dense solve scales the Jacobian in place (it is not held after). Returns
+    /// false when the solution is not finite (singular bordered matrix).
     pub fn solve_bordered<P: Problem + ?Sized>(
         &mut self,
         problem: &mut P,
