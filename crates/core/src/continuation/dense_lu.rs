@@ -49,13 +49,16 @@ impl PivotedLu {
     /// Factor the square `a`. A zero pivot is kept: solves then give non-finite values, which
     /// callers check.
     pub fn factor(&mut self, a: MatRef<'_, f64>) {
-        let n = a.nrows();
-        assert!(a.ncols() == n && n <= self.perm.len(), "LU of a matrix larger than planned");
+        self.factor_written(a.nrows(), |mut m| m.copy_from(a));
+    }
+
+    /// Factor the `n × n` matrix that `write` puts in the factors' buffer (every entry), with
+    /// no copy of its own: blocks gathered from a larger matrix.
+    pub fn factor_written(&mut self, n: usize, write: impl FnOnce(MatMut<'_, f64>)) {
+        assert!(n <= self.perm.len(), "LU of a matrix larger than planned");
         self.size = n;
         let factors = &mut self.factors[..n * n];
-        for (j, column) in factors.chunks_exact_mut(n.max(1)).enumerate().take(n) {
-            column.copy_from_slice(a.col(j).try_as_col_major().expect("column-major").as_slice());
-        }
+        write(MatMut::from_column_major_slice_mut(factors, n, n));
         let (info, _) = factor::lu_in_place(
             MatMut::from_column_major_slice_mut(factors, n, n),
             &mut self.perm[..n],

@@ -7,7 +7,7 @@
 //! blocks of half the size). For a problem that factors its own Jacobian
 //! ([`Problem::factored`]): by block elimination of the border, two solves with `∂R/∂x`.
 
-use faer::{Mat, MatRef};
+use faer::{Mat, MatMut, MatRef};
 
 use super::dense_lu::PivotedLu;
 use super::singular::Determinant;
@@ -48,32 +48,6 @@ pub(super) struct Workspace {
     border_scaled: Vec<f64>,
 }
 
-/// A square matrix and its partial-pivot LU factors.
-struct Lu {
-    matrix: Mat<f64>,
-    pivots: PivotedLu,
-}
-
-impl Lu {
-    fn new(size: usize) -> Self {
-        Lu { matrix: Mat::zeros(size, size), pivots: PivotedLu::new(size) }
-    }
-
-    /// Factor `matrix`.
-    fn factor(&mut self) {
-        self.pivots.factor(self.matrix.as_ref());
-    }
-
-    /// Overwrite `rhs` with the solution, by the factors.
-    fn solve(&mut self, rhs: &mut [f64]) {
-        self.pivots.solve(rhs);
-    }
-
-    fn determinant(&self) -> Determinant {
-        self.pivots.determinant()
-    }
-}
-
 /// A block-diagonal Jacobian `diag(J_a, J_b)` (unknowns `a` and `b`, each ascending) and its
 /// factors. The bordered system `[c_x J  c_λ r; tᵀ t_λ]` is solved by eliminating the first
 /// block: with `w = (c_x J_a)⁻¹ c_λ r_a`, the second block bordered by the Schur complement,
@@ -85,11 +59,9 @@ struct Split {
     a: Vec<usize>,
     b: Vec<usize>,
     /// `c_x J_a`, factored.
-    first: Lu,
-    /// `S` of the bordered system (size `|b| + 1`), factored.
-    second: Lu,
-    /// `c_x J_b` for a solve at fixed λ.
-    second_fixed: Lu,
+    first: PivotedLu,
+    /// `S` of the bordered system (size `|b| + 1`), or `c_x J_b` at fixed λ, factored.
+    second: PivotedLu,
     /// `w` and `t_a` of the last bordered system.
     w: Vec<f64>,
     t_a: Vec<f64>,
@@ -103,9 +75,8 @@ impl Split {
         let b: Vec<usize> = (0..n).filter(|i| a.binary_search(i).is_err()).collect();
         let (na, nb) = (a.len(), b.len());
         Split {
-            first: Lu::new(na),
-            second: Lu::new(nb + 1),
-            second_fixed: Lu::new(nb),
+            first: PivotedLu::new(na),
+            second: PivotedLu::new(nb + 1),
             w: vec![0.0; na],
             t_a: vec![0.0; na],
             rhs_a: vec![0.0; na],
@@ -118,27 +89,23 @@ impl Split {
     /// Factor the blocks of `c_x J` (in `jacobian`, n × n) for the bordered system with
     /// column `c_λ r` and row `t`.
     fn factor_bordered(&mut self, jacobian: MatRef<'_, f64>, cx: f64, border: &[f64], t: &[f64]) {
-        let nb = self.b.len();
-        gather(&mut self.first.matrix, jacobian, &self.a, cx);
-        self.first.factor();
-        for (k, &i) in self.a.iter().enumerate() {
+        let (a, b) = (&self.a, &self.b);
+        let nb = b.len();
+        self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
+        for (k, &i) in a.iter().enumerate() {
             self.w[k] = border[i];
             self.t_a[k] = t[i];
         }
         self.first.solve(&mut self.w);
-        let s = &mut self.second.matrix;
-        for (l, &j) in self.b.iter().enumerate() {
-            for (k, &i) in self.b.iter().enumerate() {
-                s[(k, l)] = jacobian[(i, j)] * cx;
-            }
-            s[(nb, l)] = t[j];
-        }
-        for (k, &i) in self.b.iter().enumerate() {
-            s[(k, nb)] = border[i];
-        }
         let t_w: f64 = self.t_a.iter().zip(&self.w).map(|(a, b)| a * b).sum();
-        s[(nb, nb)] = t[t.len() - 1] - t_w;
-        self.second.factor();
+        self.second.factor_written(nb + 1, |mut s| {
+            gather(s.as_mut().submatrix_mut(0, 0, nb, nb), jacobian, b, cx);
+            for (k, &i) in b.iter().enumerate() {
+                s[(k, nb)] = border[i];
+                s[(nb, k)] = t[i];
+            }
+            s[(nb, nb)] = t[t.len() - 1] - t_w;
+        });
     }
 
     /// Solve the bordered system factored by [`Self::factor_bordered`] for `rhs` (n + 1), in
@@ -167,10 +134,9 @@ impl Split {
 
     /// Factor and solve `c_x J Δu = rhs` (n), in place.
     fn solve_fixed(&mut self, jacobian: MatRef<'_, f64>, cx: f64, rhs: &mut [f64]) {
-        gather(&mut self.first.matrix, jacobian, &self.a, cx);
-        self.first.factor();
-        gather(&mut self.second_fixed.matrix, jacobian, &self.b, cx);
-        self.second_fixed.factor();
+        let (a, b) = (&self.a, &self.b);
+        self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
+        self.second.factor_written(b.len(), |m| gather(m, jacobian, b, cx));
         for (k, &i) in self.a.iter().enumerate() {
             self.rhs_a[k] = rhs[i];
         }
@@ -179,7 +145,7 @@ impl Split {
         for (k, &i) in self.b.iter().enumerate() {
             self.rhs_b[k] = rhs[i];
         }
-        self.second_fixed.solve(&mut self.rhs_b[..nb]);
+        self.second.solve(&mut self.rhs_b[..nb]);
         for (k, &i) in self.a.iter().enumerate() {
             rhs[i] = self.rhs_a[k];
         }
@@ -195,7 +161,7 @@ impl Split {
 }
 
 /// `block = c_x jacobian[rows, rows]`.
-fn gather(block: &mut Mat<f64>, jacobian: MatRef<'_, f64>, rows: &[usize], cx: f64) {
+fn gather(mut block: MatMut<'_, f64>, jacobian: MatRef<'_, f64>, rows: &[usize], cx: f64) {
     for (l, &j) in rows.iter().enumerate() {
         let column = jacobian.col(j);
         for (k, &i) in rows.iter().enumerate() {
@@ -438,7 +404,6 @@ impl Workspace {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::MatMut;
 
     /// `R(x, λ) = J x − λ c` with a Jacobian block diagonal in the unknowns {0, 2, 3} and
     /// {1, 4}, declared as such or not.
