@@ -296,15 +296,19 @@ fn main() {
                 }
             }
         };
-        // The receptance at the 7 harmonics for a residual, then (`complete`) the matrices H_k.
+        // The receptance at the 7 harmonics for a residual (with the matrices H_k where the
+        // residual makes them, `Receptance::prefers_matrix`), then (`complete`) the matrices
+        // H_k if it did not.
+        let matrices_in_residual = receptance.prefers_matrix();
         let mut receptance_alone = |omega: f64, complete: bool| {
             for (k, hr) in harmonic.iter_mut().enumerate() {
                 let w = (k + 1) as f64 * omega;
-                match k {
-                    0 => receptance.evaluate(w, hr),
-                    _ => receptance.evaluate_unforced(w, hr, false),
+                match (k, matrices_in_residual) {
+                    (0, false) => receptance.evaluate(w, hr),
+                    (0, true) => receptance.evaluate_matrix(w, hr),
+                    _ => receptance.evaluate_unforced(w, hr, matrices_in_residual),
                 }
-                if complete {
+                if complete && !matrices_in_residual {
                     receptance.complete_matrix(w, hr);
                 }
             }
@@ -382,13 +386,18 @@ fn main() {
             "  per point: {residuals:.2} residuals, {jacobians:.2} completed to Jacobians, {factorizations:.2} \
              bordered LU solves"
         );
+        let (made_in_residual, made_in_completion) = if matrices_in_residual {
+            (" with the matrices H_k", String::new())
+        } else {
+            ("", format!("matrices H_k {rec_j:.1}, "))
+        };
         println!(
-            "  residual   {res:>6.1} us: AFT of the 4 joints {aft_r:.1}, receptance at 7 harmonics {rec_r:.1}, \
-             products H_k G_k {:.1}",
+            "  residual   {res:>6.1} us: AFT of the 4 joints {aft_r:.1}, receptance at 7 harmonics{made_in_residual} \
+             {rec_r:.1}, products H_k G_k {:.1}",
             res - aft_r - rec_r
         );
         println!(
-            "  completion {jcb:>6.1} us: sliders' Jacobians {aft_j:.1}, matrices H_k {rec_j:.1}, 60 x 60 assembly and \
+            "  completion {jcb:>6.1} us: sliders' Jacobians {aft_j:.1}, {made_in_completion}60 x 60 assembly and \
              dR/dOmega {:.1}",
             jcb - aft_j - rec_j
         );

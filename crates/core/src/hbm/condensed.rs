@@ -100,6 +100,8 @@ pub struct CondensedHbm<'m> {
     /// evaluation's: [`Self::evaluated_at`]).
     last: Option<(f64, f64)>,
     last_x: Vec<f64>,
+    /// The last evaluation made the matrices `H_k` ([`Receptance::prefers_matrix`]).
+    matrices_made: bool,
     /// The unknowns of the even harmonics (0, 2, 4, ...), ascending.
     even_unknowns: Vec<usize>,
     /// Per element, the rows of its Jacobian of the other parity than an even column's
@@ -172,6 +174,7 @@ impl<'m> CondensedHbm<'m> {
                     && !law.depends_on_velocity()
             }),
             last: None,
+            matrices_made: false,
             last_x: vec![0.0; q * plan.n_coeffs()],
             even_unknowns: (0..plan.n_coeffs())
                 .filter(|&c| coefficient_is_even(c))
@@ -288,14 +291,17 @@ impl<'m> CondensedHbm<'m> {
         self.last = None;
         let q = self.q;
         self.element_forces(x, omega, want)?;
+        // The matrix H_k for a Jacobian, or where it costs no more than the products H_k G_k
+        // that a residual alone needs (and a Jacobian completed from this residual then finds
+        // it). The excitation's response u_F only on harmonic 1, the one it drives.
+        let matrices = want || self.receptance.prefers_matrix();
+        self.matrices_made = matrices;
         for k in 1..=self.plan.n_harmonics() {
-            // The matrix H_k only for a Jacobian: a residual needs H_k G_k alone. The
-            // excitation's response u_F only on harmonic 1, the one it drives.
             let hr = &mut self.harmonic[k - 1];
-            match (k, want) {
+            match (k, matrices) {
                 (1, true) => self.receptance.evaluate_matrix(omega, hr),
                 (1, false) => self.receptance.evaluate(omega, hr),
-                _ => self.receptance.evaluate_unforced(k as f64 * omega, hr, want),
+                _ => self.receptance.evaluate_unforced(k as f64 * omega, hr, matrices),
             }
         }
         // Harmonic 0: R_0 = x_0 + H(0) G_0.
@@ -314,8 +320,8 @@ impl<'m> CondensedHbm<'m> {
                 *a = c64::new(g[ic + j], -g[is + j]);
             }
             let hr = &mut self.harmonic[k - 1];
-            if want {
-                // H_k is there for the Jacobian: q² products instead of the modal sum's 2qm.
+            if matrices {
+                // H_k is there: q² products instead of the modal sum's 2qm.
                 multiply(&hr.h, &self.amplitudes, &mut self.product);
             } else {
                 self.receptance.apply(hr, &self.amplitudes, &mut self.product);
@@ -358,8 +364,11 @@ impl<'m> CondensedHbm<'m> {
         if !self.joints.complete_jacobian(self.model, &self.plan) {
             return false;
         }
-        for (k, hr) in self.harmonic.iter_mut().enumerate() {
-            self.receptance.complete_matrix((k + 1) as f64 * omega, hr);
+        if !self.matrices_made {
+            for (k, hr) in self.harmonic.iter_mut().enumerate() {
+                self.receptance.complete_matrix((k + 1) as f64 * omega, hr);
+            }
+            self.matrices_made = true;
         }
         self.assemble_jacobian(dx, self.plan.n_coeffs());
         self.parameter_derivatives(level, domega, dlevel);
