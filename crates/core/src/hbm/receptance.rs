@@ -24,6 +24,7 @@
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Accum, Mat, MatMut, MatRef, Par};
+use multiversion::multiversion;
 
 use crate::model::{Damping, LinearModel, ModelError, Modes};
 
@@ -119,6 +120,8 @@ pub struct HarmonicReceptance {
     inverse_derivative: [Vec<f64>; 2],
     /// Modal: a product `Aᵀ g` (m, complex as two parts), reused.
     projected: [Vec<f64>; 2],
+    /// Modal: the sums of the pairs' products, `H`'s lower triangle, reused.
+    pair_sums: Vec<(f64, f64)>,
     /// Modal: `A diag(Re 1/den)` and `A diag(Im 1/den)` (q × m), and the real and imaginary
     /// parts of `H` (lower triangles), reused from call to call.
     scaled: [Mat<f64>; 2],
@@ -137,6 +140,7 @@ impl HarmonicReceptance {
             inverse: [Vec::new(), Vec::new()],
             inverse_derivative: [Vec::new(), Vec::new()],
             projected: [Vec::new(), Vec::new()],
+            pair_sums: Vec::new(),
             scaled: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
             parts: [Mat::zeros(0, 0), Mat::zeros(0, 0)],
             dh: Mat::zeros(0, 0),
@@ -402,15 +406,9 @@ impl ModalReceptance {
         for part in out.inverse.iter_mut().chain(&mut out.inverse_derivative).chain(&mut out.projected) {
             part.resize(m, 0.0);
         }
-        let [inv_re, inv_im] = &mut out.inverse;
-        let [dinv_re, dinv_im] = &mut out.inverse_derivative;
-        for r in 0..m {
-            let den = c64::new(self.omega_r2[r] - omega * omega, omega * self.c_r[r]);
-            let inv = den.inv();
-            // d(1/den)/dω = −(−2ω + i c_r)/den² = (2ω − i c_r)/den².
-            let dinv = c64::new(2.0 * omega, -self.c_r[r]) * inv * inv;
-            (inv_re[r], inv_im[r], dinv_re[r], dinv_im[r]) = (inv.re, inv.im, dinv.re, dinv.im);
-        }
+        modal_weights(omega, &self.omega_r2, &self.c_r, &mut out.inverse, &mut out.inverse_derivative);
+        let [inv_re, inv_im] = &out.inverse;
+        let [dinv_re, dinv_im] = &out.inverse_derivative;
         if force {
             for i in 0..q {
                 let row = &self.force_rows[i * m..(i + 1) * m];
@@ -430,8 +428,10 @@ impl ModalReceptance {
         let (q, m) = (self.a.nrows(), self.omega_r.len());
         let [inv_re, inv_im] = &out.inverse;
         if q <= PAIRWISE_UP_TO {
-            for (p, (i, j)) in lower_pairs(q).enumerate() {
-                let (re, im) = dot2(&self.pairs[p * m..(p + 1) * m], inv_re, inv_im);
+            let sums = &mut out.pair_sums;
+            sums.resize(q * (q + 1) / 2, (0.0, 0.0));
+            pair_dots(&self.pairs, m, inv_re, inv_im, sums);
+            for (&(re, im), (i, j)) in sums.iter().zip(lower_pairs(q)) {
                 let v = c64::new(re, im);
                 out.h[(i, j)] = v;
                 out.h[(j, i)] = v;
@@ -475,24 +475,7 @@ impl ModalReceptance {
     /// `A diag(weights) Aᵀ g`, a receptance-like product in O(q m): `Aᵀ g` into `projected`,
     /// weighted, then one dot product per direction.
     fn apply(&self, weights: &[Vec<f64>; 2], projected: &mut [Vec<f64>; 2], g: &[c64], out: &mut [c64]) {
-        let m = self.omega_r.len();
-        let [t_re, t_im] = projected;
-        t_re.iter_mut().chain(t_im.iter_mut()).for_each(|v| *v = 0.0);
-        for (row, gj) in self.rows.chunks_exact(m).zip(g) {
-            for ((a, re), im) in row.iter().zip(t_re.iter_mut()).zip(t_im.iter_mut()) {
-                *re += a * gj.re;
-                *im += a * gj.im;
-            }
-        }
-        let [w_re, w_im] = weights;
-        for r in 0..m {
-            let t = c64::new(t_re[r], t_im[r]) * c64::new(w_re[r], w_im[r]);
-            (t_re[r], t_im[r]) = (t.re, t.im);
-        }
-        for (row, o) in self.rows.chunks_exact(m).zip(out.iter_mut()) {
-            let (re, im) = dot2(row, t_re, t_im);
-            *o = c64::new(re, im);
-        }
+        weighted_product(&self.rows, self.omega_r.len(), weights, projected, g, out);
     }
 
     fn recover(&self, omega: f64, level: f64, g: &[c64], outputs: &Outputs) -> (Vec<c64>, f64) {
@@ -597,6 +580,102 @@ impl DirectReceptance {
 /// The pairs (i, j), j ≤ i, of q directions: the lower triangle column by column.
 fn lower_pairs(q: usize) -> impl Iterator<Item = (usize, usize)> {
     (0..q).flat_map(move |j| (j..q).map(move |i| (i, j)))
+}
+
+/// The modal weights at ω: `1/den_r` and `d(1/den_r)/dω = (2ω − i c_r)/den_r²` with `den_r =
+/// ω_r² − ω² + iω c_r`, real and imaginary parts apart, into `inverse` and `derivative`
+/// (resized to the modes). The operations of `c64`'s `inv` and products, written on the parts
+/// so that the loop over the modes vectorises (the same values bit for bit).
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn modal_weights(
+    omega: f64,
+    omega_r2: &[f64],
+    c_r: &[f64],
+    inverse: &mut [Vec<f64>; 2],
+    derivative: &mut [Vec<f64>; 2],
+) {
+    let m = omega_r2.len();
+    let [inv_re, inv_im] = inverse;
+    let [dinv_re, dinv_im] = derivative;
+    let (inv_re, inv_im, dinv_re, dinv_im) = (&mut inv_re[..m], &mut inv_im[..m], &mut dinv_re[..m], &mut dinv_im[..m]);
+    let p = 2.0 * omega;
+    for r in 0..m {
+        let (a, b) = (omega_r2[r] - omega * omega, omega * c_r[r]);
+        let norm = a * a + b * b;
+        let (x, y) = (a / norm, -b / norm);
+        // (p − i c) (x + i y), then times (x + i y) again.
+        let c = -c_r[r];
+        let (tr, ti) = (p * x - c * y, p * y + c * x);
+        (inv_re[r], inv_im[r], dinv_re[r], dinv_im[r]) = (x, y, tr * x - ti * y, tr * y + ti * x);
+    }
+}
+
+/// `A diag(weights) Aᵀ g` with `A`'s rows (m each) in `rows` (see [`ModalReceptance::apply`]),
+/// `c64`'s products written on the parts so that the loops over the modes vectorise.
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn weighted_product(
+    rows: &[f64],
+    m: usize,
+    weights: &[Vec<f64>; 2],
+    projected: &mut [Vec<f64>; 2],
+    g: &[c64],
+    out: &mut [c64],
+) {
+    let [t_re, t_im] = projected;
+    let (t_re, t_im) = (&mut t_re[..m], &mut t_im[..m]);
+    t_re.iter_mut().chain(t_im.iter_mut()).for_each(|v| *v = 0.0);
+    for (row, gj) in rows.chunks_exact(m).zip(g) {
+        for ((a, re), im) in row.iter().zip(t_re.iter_mut()).zip(t_im.iter_mut()) {
+            *re += a * gj.re;
+            *im += a * gj.im;
+        }
+    }
+    let [w_re, w_im] = weights;
+    let (w_re, w_im) = (&w_re[..m], &w_im[..m]);
+    for r in 0..m {
+        let (a, b, c, d) = (t_re[r], t_im[r], w_re[r], w_im[r]);
+        (t_re[r], t_im[r]) = (a * c - b * d, a * d + b * c);
+    }
+    for (row, o) in rows.chunks_exact(m).zip(out.iter_mut()) {
+        let (re, im) = dot2(row, t_re, t_im);
+        *o = c64::new(re, im);
+    }
+}
+
+/// [`dot2`] of every pair's products (`pairs`, m each) with `(x, y)`, into `sums`: four pairs at
+/// a time, so that their sums run side by side (a single pair's four partial sums wait on one
+/// another), each pair's the same operations in the same order as `dot2` (the same values).
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn pair_dots(pairs: &[f64], m: usize, x: &[f64], y: &[f64], sums: &mut [(f64, f64)]) {
+    const PAIRS: usize = 4;
+    let full = sums.len() / PAIRS * PAIRS;
+    let (x, y) = (&x[..m], &y[..m]);
+    let chunks = m / 4 * 4;
+    for (block, out) in sums[..full].chunks_exact_mut(PAIRS).enumerate() {
+        let rows: [&[f64]; PAIRS] =
+            std::array::from_fn(|p| &pairs[(block * PAIRS + p) * m..(block * PAIRS + p + 1) * m]);
+        let (mut sx, mut sy) = ([[0.0; 4]; PAIRS], [[0.0; 4]; PAIRS]);
+        for r in (0..chunks).step_by(4) {
+            for p in 0..PAIRS {
+                for l in 0..4 {
+                    sx[p][l] += rows[p][r + l] * x[r + l];
+                    sy[p][l] += rows[p][r + l] * y[r + l];
+                }
+            }
+        }
+        for p in 0..PAIRS {
+            let (sx, sy) = (sx[p], sy[p]);
+            let (mut tx, mut ty) = ((sx[0] + sx[1]) + (sx[2] + sx[3]), (sy[0] + sy[1]) + (sy[2] + sy[3]));
+            for r in chunks..m {
+                tx += rows[p][r] * x[r];
+                ty += rows[p][r] * y[r];
+            }
+            out[p] = (tx, ty);
+        }
+    }
+    for (p, out) in sums.iter_mut().enumerate().skip(full) {
+        *out = dot2(&pairs[p * m..(p + 1) * m], x, y);
+    }
 }
 
 /// `(Σ a x, Σ a y)`: two dot products sharing `a`, on four independent partial sums each so
