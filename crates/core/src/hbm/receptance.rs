@@ -48,8 +48,10 @@ pub struct ModalReceptance {
     /// The same data laid out for loops over the modes, which are the long dimension (q is a
     /// few directions, m every mode of the model): `ω_r²`, the rows of `A` (`rows[i·m + r]`),
     /// the rows of `A diag(b)` (`u_F`'s weights), and for few directions
-    /// ([`PAIRWISE_UP_TO`]) the products `a_ir a_jr` of each pair j ≤ i (`pairs[p·m + r]`),
-    /// so that an entry of `H` is one dot product with the modal weights.
+    /// ([`PAIRWISE_UP_TO`]) the products `a_ir a_jr` of each pair j ≤ i, so that an entry of
+    /// `H` is one dot product with the modal weights: four pairs side by side
+    /// (`pairs[(b·m + r)·4 + p]` for pair 4b + p, zero beyond the last), the lanes of one
+    /// vector ([`pair_dots`]).
     omega_r2: Vec<f64>,
     rows: Vec<f64>,
     force_rows: Vec<f64>,
@@ -168,10 +170,15 @@ impl Receptance {
             let rows = (0..q).flat_map(|i| (0..m).map(move |r| (i, r))).map(|(i, r)| a[(i, r)]).collect();
             let force_rows = (0..q).flat_map(|i| (0..m).map(move |r| (i, r))).map(|(i, r)| a[(i, r)] * b[r]).collect();
             let pairs = if q <= PAIRWISE_UP_TO {
-                lower_pairs(q)
-                    .flat_map(|(i, j)| (0..m).map(move |r| (i, j, r)))
-                    .map(|(i, j, r)| a[(i, r)] * a[(j, r)])
-                    .collect()
+                let list: Vec<(usize, usize)> = lower_pairs(q).collect();
+                let mut pairs = vec![0.0; list.len().div_ceil(PAIR_LANES) * m * PAIR_LANES];
+                for (p, &(i, j)) in list.iter().enumerate() {
+                    let (block, lane) = (p / PAIR_LANES, p % PAIR_LANES);
+                    for r in 0..m {
+                        pairs[(block * m + r) * PAIR_LANES + lane] = a[(i, r)] * a[(j, r)];
+                    }
+                }
+                pairs
             } else {
                 Vec::new()
             };
@@ -642,40 +649,54 @@ fn weighted_product(
     }
 }
 
-/// [`dot2`] of every pair's products (`pairs`, m each) with `(x, y)`, into `sums`: four pairs at
-/// a time, so that their sums run side by side (a single pair's four partial sums wait on one
-/// another), each pair's the same operations in the same order as `dot2` (the same values).
+/// Pairs summed side by side by [`pair_dots`].
+const PAIR_LANES: usize = 4;
+
+/// [`dot2`] of every pair's products with `(x, y)`, into `sums` (the q(q+1)/2 pairs):
+/// [`PAIR_LANES`] pairs at a time as the lanes of one vector (`pairs` laid out so), each
+/// pair's sum split by the mode's index modulo 4 into four partial sums added as `dot2` adds
+/// its own, so that every pair's sum is `dot2`'s, the same operations in the same order (the
+/// same values), without `dot2`'s wait on its four sums.
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn pair_dots(pairs: &[f64], m: usize, x: &[f64], y: &[f64], sums: &mut [(f64, f64)]) {
-    const PAIRS: usize = 4;
-    let full = sums.len() / PAIRS * PAIRS;
-    let (x, y) = (&x[..m], &y[..m]);
+    for (block, out) in sums.chunks_mut(PAIR_LANES).enumerate() {
+        let products = &pairs[block * m * PAIR_LANES..(block + 1) * m * PAIR_LANES];
+        // The x and y sums apart, so that the lanes are the pairs.
+        let (tx, ty) = (lane_dot(products, &x[..m]), lane_dot(products, &y[..m]));
+        for (p, o) in out.iter_mut().enumerate() {
+            *o = (tx[p], ty[p]);
+        }
+    }
+}
+
+/// `Σ_r products[r][p] x[r]` for each lane p, split by r modulo 4 as [`dot2`] splits its sums.
+#[inline(always)]
+fn lane_dot(products: &[f64], x: &[f64]) -> [f64; PAIR_LANES] {
+    const L: usize = PAIR_LANES;
+    let m = x.len();
     let chunks = m / 4 * 4;
-    for (block, out) in sums[..full].chunks_exact_mut(PAIRS).enumerate() {
-        let rows: [&[f64]; PAIRS] =
-            std::array::from_fn(|p| &pairs[(block * PAIRS + p) * m..(block * PAIRS + p + 1) * m]);
-        let (mut sx, mut sy) = ([[0.0; 4]; PAIRS], [[0.0; 4]; PAIRS]);
-        for r in (0..chunks).step_by(4) {
-            for p in 0..PAIRS {
-                for l in 0..4 {
-                    sx[p][l] += rows[p][r + l] * x[r + l];
-                    sy[p][l] += rows[p][r + l] * y[r + l];
-                }
+    let at = |r: usize| -> &[f64; L] { products[r * L..(r + 1) * L].try_into().expect("a block of pairs") };
+    // [r mod 4][pair]
+    let mut partial = [[0.0; L]; 4];
+    for r in (0..chunks).step_by(4) {
+        for (l, sum) in partial.iter_mut().enumerate() {
+            let (a, xr) = (at(r + l), x[r + l]);
+            for p in 0..L {
+                sum[p] += a[p] * xr;
             }
         }
-        for p in 0..PAIRS {
-            let (sx, sy) = (sx[p], sy[p]);
-            let (mut tx, mut ty) = ((sx[0] + sx[1]) + (sx[2] + sx[3]), (sy[0] + sy[1]) + (sy[2] + sy[3]));
-            for r in chunks..m {
-                tx += rows[p][r] * x[r];
-                ty += rows[p][r] * y[r];
-            }
-            out[p] = (tx, ty);
+    }
+    let mut total = [0.0; L];
+    for p in 0..L {
+        total[p] = (partial[0][p] + partial[1][p]) + (partial[2][p] + partial[3][p]);
+    }
+    for (r, &xr) in x.iter().enumerate().skip(chunks) {
+        let a = at(r);
+        for p in 0..L {
+            total[p] += a[p] * xr;
         }
     }
-    for (p, out) in sums.iter_mut().enumerate().skip(full) {
-        *out = dot2(&pairs[p * m..(p + 1) * m], x, y);
-    }
+    total
 }
 
 /// `(Σ a x, Σ a y)`: two dot products sharing `a`, on four independent partial sums each so
@@ -703,5 +724,69 @@ fn dot2(a: &[f64], x: &[f64], y: &[f64]) -> (f64, f64) {
 fn multiply(h: &Mat<c64>, g: &[c64], out: &mut [c64]) {
     for (i, o) in out.iter_mut().enumerate() {
         *o = (0..g.len()).map(|j| h[(i, j)] * g[j]).sum();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reproducible values in [−1, 1] (a linear congruential sequence).
+    fn values(n: usize, seed: u64) -> Vec<f64> {
+        let mut state = seed;
+        (0..n)
+            .map(|_| {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            })
+            .collect()
+    }
+
+    /// The pairs summed side by side are `dot2`'s sums bit for bit (the modal receptance's
+    /// values must not depend on how its loops are vectorised), for mode counts with and
+    /// without a remainder modulo 4 and pair counts filling a block of lanes or not.
+    #[test]
+    fn pairs_summed_side_by_side_are_dot2_bit_for_bit() {
+        for m in [1, 3, 4, 7, 137] {
+            for count in [1usize, 3, 4, 6, 10] {
+                let rows: Vec<Vec<f64>> = (0..count).map(|p| values(m, 7 + p as u64)).collect();
+                let mut pairs = vec![0.0; count.div_ceil(PAIR_LANES) * m * PAIR_LANES];
+                for (p, row) in rows.iter().enumerate() {
+                    for (r, v) in row.iter().enumerate() {
+                        pairs[((p / PAIR_LANES) * m + r) * PAIR_LANES + p % PAIR_LANES] = *v;
+                    }
+                }
+                let (x, y) = (values(m, 1), values(m, 2));
+                let mut sums = vec![(0.0, 0.0); count];
+                pair_dots(&pairs, m, &x, &y, &mut sums);
+                for (p, row) in rows.iter().enumerate() {
+                    let (a, b) = dot2(row, &x, &y);
+                    assert_eq!(
+                        (sums[p].0.to_bits(), sums[p].1.to_bits()),
+                        (a.to_bits(), b.to_bits()),
+                        "m {m}, pair {p}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The modal weights written on the parts are `c64`'s `inv` and products bit for bit.
+    #[test]
+    fn modal_weights_are_the_complex_operations_bit_for_bit() {
+        let m = 37;
+        let omega_r2: Vec<f64> = values(m, 3).iter().map(|v| 1e6 * (1.0 + v)).collect();
+        let c_r: Vec<f64> = values(m, 4).iter().map(|v| 10.0 * (1.0 + v)).collect();
+        for omega in [0.0, 3.0, 700.0, 1e4] {
+            let (mut inverse, mut derivative) = ([vec![0.0; m], vec![0.0; m]], [vec![0.0; m], vec![0.0; m]]);
+            modal_weights(omega, &omega_r2, &c_r, &mut inverse, &mut derivative);
+            for r in 0..m {
+                let inv = c64::new(omega_r2[r] - omega * omega, omega * c_r[r]).inv();
+                let dinv = c64::new(2.0 * omega, -c_r[r]) * inv * inv;
+                let got = [inverse[0][r], inverse[1][r], derivative[0][r], derivative[1][r]];
+                let expected = [inv.re, inv.im, dinv.re, dinv.im];
+                assert_eq!(got.map(f64::to_bits), expected.map(f64::to_bits), "ω {omega}, mode {r}");
+            }
+        }
     }
 }
