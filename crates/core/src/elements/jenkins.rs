@@ -129,18 +129,50 @@ impl Element for Jenkins {
         let (k, fc) = (self.stiffness, self.threshold);
         let slip_offset = fc / k;
         let linear = if self.replaces_stiffness { k } else { 0.0 };
+        let (u, g, slipping) = (&u[range.clone()], &mut g[range.clone()], &mut slipping[range]);
+        let n = u.len();
         let mut w = *state;
-        for j in range {
-            let before = w;
-            let trial = k * (u[j] - w);
-            let f = if trial.abs() < fc {
-                trial
-            } else {
+        // One loop per state, each exit a branch: the slider's position then never waits on
+        // its previous value's comparison (a single loop compiles to a select whose chain
+        // through w costs ~12 cycles a sample). Sliding forward, w = u − F_c/k and
+        // f = F_c are the return mapping's `u − sgn(f_tr) F_c/k` and `sgn(f_tr) F_c` exactly.
+        let mut j = 0;
+        while j < n {
+            let start = j;
+            // Stuck: w kept.
+            while j < n {
+                let trial = k * (u[j] - w);
+                if trial.abs() < fc {
+                    g[j] = trial - linear * u[j];
+                    slipping[j] = false;
+                    j += 1;
+                } else {
+                    break;
+                }
+            }
+            // Sliding forward, then back.
+            while j < n && k * (u[j] - w) >= fc {
+                let before = w;
+                w = u[j] - slip_offset;
+                g[j] = fc - linear * u[j];
+                slipping[j] = before != w;
+                j += 1;
+            }
+            while j < n && k * (u[j] - w) <= -fc {
+                let before = w;
+                w = u[j] + slip_offset;
+                g[j] = -fc - linear * u[j];
+                slipping[j] = before != w;
+                j += 1;
+            }
+            if j == start {
+                // A trial force that is not a number: the return mapping's step as it is.
+                let (before, trial) = (w, k * (u[j] - w));
                 w = u[j] - trial.signum() * slip_offset;
-                trial.signum() * fc
-            };
-            g[j] = f - linear * u[j];
-            slipping[j] = before != w;
+                g[j] = trial.signum() * fc - linear * u[j];
+                slipping[j] = before != w;
+                j += 1;
+            }
         }
         *state = w;
     }
@@ -225,6 +257,42 @@ mod tests {
                 }
                 assert_eq!(w[0].to_bits(), w_fast.to_bits());
             }
+        }
+    }
+
+    /// The same over the AFT's three stretches (the start sample, the rest of the period, the
+    /// samples before the start) and on motions with a sample that is not finite (a NaN or an
+    /// infinite trial force takes the return mapping's step, and the march goes on).
+    #[test]
+    fn stretches_and_non_finite_samples_march_as_the_return_mapping() {
+        let law = Jenkins::new(8.11e6, 300.0).unwrap();
+        let mut cases = motions();
+        cases.truncate(40);
+        for (case, u) in cases.iter_mut().enumerate() {
+            if case % 3 == 1 {
+                u[17 + case] = f64::NAN;
+            } else if case % 3 == 2 {
+                u[5 * case] = f64::INFINITY;
+            }
+        }
+        for (case, u) in cases.iter().enumerate() {
+            let nt = u.len();
+            let v = vec![0.0; nt];
+            let j0 = (7 * case) % nt;
+            let (mut g_fast, mut slip_fast) = (vec![0.0; nt], vec![false; nt]);
+            let mut w_fast = 0.0;
+            for range in [j0..j0 + 1, j0 + 1..nt, 0..j0] {
+                law.update_slider_samples(u, &v, range, &mut w_fast, &mut g_fast, &mut slip_fast);
+            }
+            let mut w = [0.0];
+            for j in (j0..nt).chain(0..j0) {
+                let before = w;
+                let mut g = [0.0];
+                law.update(&u[j..j + 1], &v[j..j + 1], &mut w, &mut g, None);
+                assert_eq!(g[0].to_bits(), g_fast[j].to_bits(), "case {case}: force at sample {j}");
+                assert_eq!(law.is_slipping(&before, &w), slip_fast[j], "case {case}: slip flag at sample {j}");
+            }
+            assert_eq!(w[0].to_bits(), w_fast.to_bits(), "case {case}");
         }
     }
 
