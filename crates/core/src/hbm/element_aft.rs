@@ -370,27 +370,31 @@ impl ElementAft {
         // The stick phases in marching order (first sample, samples, anchor): the samples
         // stuck to one anchor, or at rest with none (`NO_ANCHOR`: stuck since the march began,
         // the stuck-mean convention: a weight, no memory term).
-        const SLIPPING: usize = usize::MAX;
         const NO_ANCHOR: usize = usize::MAX - 1;
+        // A phase is a run of stuck samples: no slip within it, so one anchor (the march's
+        // last slip before it). The runs are found by scanning the slip flags for their
+        // changes, in marching order (from j0 to the period's end, then from 0 to j0).
         self.stick_phases.clear();
-        let mut current = SLIPPING;
-        let mut start = 0;
-        for i in 0..=nt {
-            let j = wrap(j0 + i, nt);
-            let a = if i == nt || self.slipping[j] {
-                SLIPPING
-            } else if self.anchor[j] == usize::MAX {
-                NO_ANCHOR
-            } else {
-                self.anchor[j]
-            };
-            if a != current {
-                if current != SLIPPING {
-                    self.stick_phases.push((wrap(j0 + start, nt), i - start, current));
-                }
-                current = a;
-                start = i;
+        let (head, tail) = (&self.slipping[j0..nt], &self.slipping[..j0]);
+        // The first marching index from `from` on whose flag is `slipping`, or nt.
+        let next = |from: usize, slipping: bool| -> usize {
+            if let Some(p) = head.get(from..).and_then(|h| h.iter().position(|&s| s == slipping)) {
+                return from + p;
             }
+            let skip = from.saturating_sub(head.len());
+            tail[skip..].iter().position(|&s| s == slipping).map_or(nt, |p| head.len() + skip + p)
+        };
+        let mut i = 0;
+        loop {
+            let start = next(i, false);
+            if start >= nt {
+                break;
+            }
+            let end = next(start, true);
+            let first = wrap(j0 + start, nt);
+            let anchor = if self.anchor[first] == usize::MAX { NO_ANCHOR } else { self.anchor[first] };
+            self.stick_phases.push((first, end - start, anchor));
+            i = end;
         }
         // Fourier sums of w_j = k s_j − k_r up to harmonic 2N: k times the stick phases' sums,
         // less k_r Σ_j cos mθ_j = k_r n_t δ_m0 (Σ_j sin mθ_j = 0; m ≤ 2N < n_t).
