@@ -20,6 +20,7 @@
 //! ```
 
 use faer::{c64, Mat, MatMut};
+use multiversion::multiversion;
 
 use super::element_aft::{AftError, ElementAft};
 use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
@@ -85,6 +86,8 @@ pub struct CondensedHbm<'m> {
     h0: Mat<f64>,
     /// Complex force amplitudes of one harmonic and a receptance product, reused.
     amplitudes: Vec<c64>,
+    /// The columns of the `H_k` laid out for the assembly ([`Self::assemble_jacobian`]).
+    h_columns: Vec<f64>,
     product: Vec<c64>,
     /// `∂R/∂x` of the last [`Self::evaluate_factored`].
     factored: Option<StructuredJacobian>,
@@ -162,6 +165,7 @@ impl<'m> CondensedHbm<'m> {
             harmonic: (0..plan.n_harmonics()).map(|_| HarmonicReceptance::new(q)).collect(),
             h0,
             amplitudes: vec![c64::new(0.0, 0.0); q],
+            h_columns: Vec::new(),
             product: vec![c64::new(0.0, 0.0); q],
             factored: None,
             reduced_factor: None,
@@ -462,62 +466,37 @@ impl<'m> CondensedHbm<'m> {
                 )
             });
         let split = self.parity_split;
-        // ∂R/∂x = I + H_block ∂G/∂x. ∂G/∂x is block diagonal over elements (an element's force
-        // depends on its own directions only), so column (c2, off+b) of element e only meets
-        // the columns off..off+d of H: O(q nc² d²) per element instead of O(q³ nc²).
-        // Every entry of a column is written (each row meets one harmonic's H), so the matrix
-        // needs no fill: the first direction's term is stored (`t + 0.0`: a −0 product as +0,
-        // as a sum from zero stores it), the others added, the identity last; split, the rows
-        // of the other parity are zero.
-        let (h0, harmonic) = (&self.h0, &self.harmonic);
+        // Each column of the H_k, harmonic after harmonic, with its real and imaginary parts
+        // apart: laid out as a column of ∂R/∂x below its first q rows (cos then sin rows of
+        // each harmonic), so that a column is assembled by one pass over both.
+        let n_harmonics = self.plan.n_harmonics();
+        let per_direction = 2 * q * n_harmonics;
+        self.h_columns.resize(q * per_direction, 0.0);
+        for (k, hr) in self.harmonic.iter().enumerate() {
+            for j in 0..q {
+                let block = &mut self.h_columns[j * per_direction + k * 2 * q..j * per_direction + (k + 1) * 2 * q];
+                let (re, im) = block.split_at_mut(q);
+                for ((re, im), h) in re.iter_mut().zip(im.iter_mut()).zip(hr.h.col_as_slice(j)) {
+                    (*re, *im) = (h.re, h.im);
+                }
+            }
+        }
         for (e, site) in self.model.elements.iter().enumerate() {
             let d = site.law.n_dirs();
             let off = self.joints.offsets[e];
+            let element = ElementColumns {
+                q,
+                d,
+                h0: self.h0.as_ref().subcols(off, d),
+                h_columns: &self.h_columns[off * per_direction..(off + d) * per_direction],
+            };
             let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
-                let even_column = coefficient_is_even(c2);
+                let even = split.then_some(coefficient_is_even(c2));
                 for b in 0..d {
-                    // One column of ∂R/∂x and of the element's block, as contiguous slices
-                    // (this runs at every Newton iteration), a column of H at a time.
                     let col = c2 * q + off + b;
-                    let jcol = je.col_as_slice(c2 * d + b);
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    if split && !even_column {
-                        column[..q].fill(0.0);
-                    } else {
-                        for a in 0..d {
-                            let g = jcol[a];
-                            for (out, h) in column[..q].iter_mut().zip(h0.col_as_slice(off + a)) {
-                                if a == 0 {
-                                    *out = h * g + 0.0;
-                                } else {
-                                    *out += h * g;
-                                }
-                            }
-                        }
-                    }
-                    for k in 1..=self.plan.n_harmonics() {
-                        let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
-                        if split && (k % 2 == 0) != even_column {
-                            column[ic..is + q].fill(0.0);
-                            continue;
-                        }
-                        let h = &harmonic[k - 1].h;
-                        let (ec, es) = (cos_index(k) * d, sin_index(k) * d);
-                        let (cos_rows, sin_rows) = column[ic..is + q].split_at_mut(q);
-                        for a in 0..d {
-                            let (gc, gs) = (jcol[ec + a], jcol[es + a]);
-                            let rows = cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(h.col_as_slice(off + a));
-                            for ((oc, os), h) in rows {
-                                let (c, s) = (h.re * gc + h.im * gs, -h.im * gc + h.re * gs);
-                                if a == 0 {
-                                    (*oc, *os) = (c + 0.0, s + 0.0);
-                                } else {
-                                    (*oc, *os) = (*oc + c, *os + s);
-                                }
-                            }
-                        }
-                    }
+                    assemble_column(column, &element, je.col_as_slice(c2 * d + b), even);
                     column[col] += 1.0;
                 }
             }
@@ -718,6 +697,68 @@ pub fn complex_amplitude(x: &[f64], width: usize, k: usize, i: usize) -> c64 {
     c64::new(x[cos_index(k) * width + i], -x[sin_index(k) * width + i])
 }
 
+/// What the columns of one element's block of `∂R/∂x` read: the columns off..off+d of
+/// `H(0)` (`h0`) and of the `H_k` (`h_columns`, as [`CondensedHbm::assemble_jacobian`] lays
+/// them out, `2qN` per direction).
+struct ElementColumns<'a> {
+    q: usize,
+    d: usize,
+    h0: faer::MatRef<'a, f64>,
+    h_columns: &'a [f64],
+}
+
+/// One column of `∂R/∂x = I + H_block ∂G/∂x` without its identity term, from the element's
+/// column `jcol` of `∂G/∂x` (its d directions' coefficients): ∂G/∂x is block diagonal over
+/// elements, so the column only meets the element's d columns of H, O(nc d) per entry
+/// instead of O(q). Every entry is written (each row meets one harmonic's H), so the matrix
+/// needs no fill: the first direction's term is stored (`t + 0.0`: a −0 product as +0, as a
+/// sum from zero stores it), the others added, in the order of the directions. `even` is
+/// `Some(the column is of an even harmonic)` where the matrix is split by parity: the rows of
+/// the other parity are then zero, written as H times zero (the H_k are finite where a
+/// Jacobian is asked: its residual was).
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn assemble_column(column: &mut [f64], element: &ElementColumns<'_>, jcol: &[f64], even: Option<bool>) {
+    let ElementColumns { q, d, h0, h_columns } = *element;
+    let (head, rest) = column.split_at_mut(q);
+    if even == Some(false) {
+        head.fill(0.0);
+    } else {
+        for a in 0..d {
+            let g = jcol[a];
+            for (out, h) in head.iter_mut().zip(h0.col(a).iter()) {
+                if a == 0 {
+                    *out = h * g + 0.0;
+                } else {
+                    *out += h * g;
+                }
+            }
+        }
+    }
+    let per_direction = rest.len();
+    for a in 0..d {
+        let h = &h_columns[a * per_direction..(a + 1) * per_direction];
+        for (k0, (out, h)) in rest.chunks_exact_mut(2 * q).zip(h.chunks_exact(2 * q)).enumerate() {
+            let k = k0 + 1;
+            let (gc, gs) = if even.is_some_and(|even| (k % 2 == 0) != even) {
+                (0.0, 0.0)
+            } else {
+                (jcol[cos_index(k) * d + a], jcol[sin_index(k) * d + a])
+            };
+            let (cos_rows, sin_rows) = out.split_at_mut(q);
+            let (re, im) = h.split_at(q);
+            let rows = cos_rows.iter_mut().zip(sin_rows.iter_mut()).zip(re.iter().zip(im));
+            for ((oc, os), (hr, hi)) in rows {
+                let (c, s) = (hr * gc + hi * gs, -hi * gc + hr * gs);
+                if a == 0 {
+                    (*oc, *os) = (c + 0.0, s + 0.0);
+                } else {
+                    (*oc, *os) = (*oc + c, *os + s);
+                }
+            }
+        }
+    }
+}
+
 /// Coupling between harmonics of opposite parity in an element's Jacobian below this,
 /// relative to its largest term, counts as none (the AFT of a half-wave symmetric motion
 /// leaves ~1e-16 there; an unsymmetric stick pattern, at least one sample in n_t).
@@ -738,16 +779,31 @@ fn coefficient_is_even(c: usize) -> bool {
 /// opposite parity by no more than [`PARITY_COUPLING`] of its largest term or of its
 /// `stiffness`, whichever is larger? (A stuck slider that replaces the stiffness of its joint
 /// has a Jacobian of round-off alone: `k s_j − k_r = 0`.)
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn parity_coupling_negligible(jacobian: &Mat<f64>, d: usize, masks: &[Vec<f64>; 2], stiffness: f64) -> bool {
-    let (mut largest, mut across) = (0.0_f64, 0.0_f64);
     // Per column, the largest term and the largest of the other parity's rows (through the
-    // 0/1 mask: one pass without branches, which the compiler vectorises).
+    // 0/1 mask: one pass without branches), in four lanes the compiler vectorises (a maximum
+    // does not depend on the order it is taken in; a NaN term is passed over, as `f64::max`
+    // passes it over).
+    const L: usize = 4;
+    let (mut largest, mut across) = ([0.0_f64; L], [0.0_f64; L]);
+    let keep = |m: f64, x: f64| if x > m { x } else { m };
     for j in 0..jacobian.ncols() {
         let mask = &masks[usize::from(!coefficient_is_even(j / d))];
-        for (v, m) in jacobian.col_as_slice(j).iter().zip(mask) {
-            largest = largest.max(v.abs());
-            across = across.max(v.abs() * m);
+        let column = jacobian.col_as_slice(j);
+        let (values, masks) = (column.chunks_exact(L), mask[..column.len()].chunks_exact(L));
+        let (value_tail, mask_tail) = (values.remainder(), masks.remainder());
+        for (v, m) in values.zip(masks) {
+            for l in 0..L {
+                largest[l] = keep(largest[l], v[l].abs());
+                across[l] = keep(across[l], v[l].abs() * m[l]);
+            }
+        }
+        for (l, (v, m)) in value_tail.iter().zip(mask_tail).enumerate() {
+            largest[l] = keep(largest[l], v.abs());
+            across[l] = keep(across[l], v.abs() * m);
         }
     }
+    let (largest, across) = (largest.into_iter().fold(0.0, keep), across.into_iter().fold(0.0, keep));
     across <= PARITY_COUPLING * largest.max(stiffness)
 }
