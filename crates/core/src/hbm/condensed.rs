@@ -714,8 +714,9 @@ struct ElementColumns<'a> {
 /// needs no fill: the first direction's term is stored (`t + 0.0`: a −0 product as +0, as a
 /// sum from zero stores it), the others added, in the order of the directions. `even` is
 /// `Some(the column is of an even harmonic)` where the matrix is split by parity: the rows of
-/// the other parity are then zero, written as H times zero (the H_k are finite where a
-/// Jacobian is asked: its residual was).
+/// the other parity are then zero, written as H times zero: the same zeros while H_k is
+/// finite (an infinite H_k, a resonance without damping, leaves the column's own parity
+/// infinite as well, and the matrix fails to factor either way).
 #[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
 fn assemble_column(column: &mut [f64], element: &ElementColumns<'_>, jcol: &[f64], even: Option<bool>) {
     let ElementColumns { q, d, h0, h_columns } = *element;
