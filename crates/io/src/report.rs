@@ -281,6 +281,12 @@ fn fixed(v: f64, digits: usize) -> String {
     }
 }
 
+/// A stage's time in seconds: to the microsecond below a second (the stages of a small
+/// study take fractions of a millisecond), to the millisecond above.
+fn duration(seconds: f64) -> String {
+    fixed(seconds, if seconds < 1.0 { 6 } else { 3 })
+}
+
 /// A finite value to 4 significant digits (plain for moderate magnitudes, exponent form
 /// otherwise), a dash otherwise.
 fn sig(v: f64) -> String {
@@ -440,7 +446,7 @@ pub fn render(data: &ReportData) -> Result<String, ReportError> {
                 "<tr><td style=\"padding-left:{}em\">{}</td><td class=\"num\">{}</td></tr>",
                 0.5 + indent as f64,
                 escape(name),
-                fixed(*seconds, 4)
+                duration(*seconds)
             );
         }
         h.push_str("</table>\n");

@@ -142,7 +142,7 @@ fn refined_stability(
     omega: f64,
     reference: bool,
 ) -> Result<Stability, BranchStabilityError> {
-    let mut stability = hill.exponents(omega, jacobian.as_ref())?;
+    let (mut stability, blocks) = hill.exponents_in_blocks(omega, jacobian.as_ref())?;
     if !hbm.has_memory_delay() {
         return Ok(stability);
     }
@@ -156,7 +156,9 @@ fn refined_stability(
         let newton = match reference {
             true => None,
             false => hill
-                .refine(omega, start, None, true, MEMORY_ITERATIONS, |s| hbm.delayed_force_jacobian(omega, s))?
+                .refine(omega, start, None, blocks[i], true, MEMORY_ITERATIONS, |s| {
+                    hbm.delayed_force_jacobian(omega, s)
+                })?
                 .map(|r| r.exponent)
                 .filter(|s| (s - start).norm() <= CLOSE_ROOT * nearest.min(omega)),
         };

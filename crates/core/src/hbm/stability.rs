@@ -163,14 +163,39 @@ impl Hill {
     /// Jacobian is `jacobian` (`∂G/∂x`, q(2N+1) square, coefficient-major as the balance's
     /// unknowns: [`super::CondensedHbm::element_force_jacobian`]).
     pub fn exponents(&self, omega: f64, jacobian: MatRef<'_, f64>) -> Result<Stability, StabilityError> {
+        Ok(self.exponents_in_blocks(omega, jacobian)?.0)
+    }
+
+    /// [`Self::exponents`], with the parity of the harmonics of each exponent's eigenvector
+    /// (0 even, 1 odd) where Hill's matrix split into even and odd harmonics (`None` where it
+    /// did not): the block [`Self::refine`] may then work in.
+    pub fn exponents_in_blocks(
+        &self,
+        omega: f64,
+        jacobian: MatRef<'_, f64>,
+    ) -> Result<(Stability, Vec<Option<usize>>), StabilityError> {
         let complex = Mat::from_fn(jacobian.nrows(), jacobian.ncols(), |i, j| c64::new(jacobian[(i, j)], 0.0));
-        let all = self.eigenvalues(omega, complex.as_ref())?;
-        Ok(Stability { exponents: self.physical(all) })
+        let mut all = self.eigenvalues_in_blocks(omega, complex.as_ref())?;
+        // The same order as `physical` (stable sorts on the values alone).
+        all.sort_by(|a, b| a.0.im.abs().total_cmp(&b.0.im.abs()));
+        all.truncate(2 * self.n_modes());
+        all.sort_by(|a, b| b.0.re.total_cmp(&a.0.re).then(b.0.im.total_cmp(&a.0.im)));
+        let (exponents, blocks) = all.into_iter().unzip();
+        Ok((Stability { exponents }, blocks))
     }
 
     /// Every eigenvalue of Hill's problem with the joints' Jacobian `jacobian` (complex when
     /// it depends on the exponent: [`super::CondensedHbm::delayed_force_jacobian`]).
     pub fn eigenvalues(&self, omega: f64, jacobian: MatRef<'_, c64>) -> Result<Vec<c64>, StabilityError> {
+        Ok(self.eigenvalues_in_blocks(omega, jacobian)?.into_iter().map(|(s, _)| s).collect())
+    }
+
+    /// [`Self::eigenvalues`], each with the parity block it came from (`None`: not split).
+    fn eigenvalues_in_blocks(
+        &self,
+        omega: f64,
+        jacobian: MatRef<'_, c64>,
+    ) -> Result<Vec<(c64, Option<usize>)>, StabilityError> {
         let q = self.a.nrows();
         let m = self.n_modes();
         let nq = jacobian.nrows();
@@ -237,9 +262,9 @@ impl Hill {
             Ok(all)
         };
         // Parity of the harmonic of companion row/column i.
-        let parity = |i: usize| ((i % size) / m).div_ceil(2) % 2;
+        let parity = |i: usize| coefficient_parity((i % size) / m);
         if !(self.split_parity && half_wave_symmetric(&k_nl, |i| parity(i) == 1)) {
-            return solve(companion);
+            return Ok(solve(companion)?.into_iter().map(|s| (s, None)).collect());
         }
         // Half-wave symmetry (x(t + T/2) = −x(t): an odd law, such as a Jenkins slider or a
         // cubic spring, driven at the fundamental without a static load) leaves only odd
@@ -253,7 +278,8 @@ impl Hill {
         let mut all = Vec::with_capacity(2 * size);
         for p in 0..2 {
             let block: Vec<usize> = (0..2 * size).filter(|&i| parity(i) == p).collect();
-            all.extend(solve(Mat::from_fn(block.len(), block.len(), |a, b| companion[(block[a], block[b])]))?);
+            let block = Mat::from_fn(block.len(), block.len(), |a, b| companion[(block[a], block[b])]);
+            all.extend(solve(block)?.into_iter().map(|s| (s, Some(p))));
         }
         Ok(all)
     }
@@ -395,13 +421,19 @@ impl Hill {
     /// Adding it by central differences (two more stiffness evaluations a step) cost more time
     /// than the steps it saved at paper size (15.8 against 10.3 ms a point, measured at the same load).
     ///
+    /// With `block` (the parity of the start's eigenvector, from [`Self::exponents_in_blocks`])
+    /// and a joints' Jacobian that keeps even and odd harmonics apart, Newton works in that
+    /// block of `T(s)` alone (LUs of half the size); the vector returned is Hill's whole `P`.
+    ///
     /// `None` if the iteration does not settle within `max_iterations` (to `1e-11 Ω`, or to
     /// round-off, where the steps stop decreasing below `1e-8 Ω`).
+    #[allow(clippy::too_many_arguments)]
     pub fn refine(
         &self,
         omega: f64,
         start: c64,
         vector: Option<&[c64]>,
+        block: Option<usize>,
         depends_on_s: bool,
         max_iterations: usize,
         mut jacobian: impl FnMut(c64) -> Mat<c64>,
@@ -413,6 +445,11 @@ impl Hill {
         let mut k_nl: Option<Mat<c64>> = None;
         let (mut x, mut v): (Vec<c64>, Vec<c64>) = (Vec::new(), Vec::new());
         let mut previous = f64::INFINITY;
+        // The rows of Hill's matrix worked in (its own parity block, or all), and the joints'
+        // Jacobian's coefficients of that parity; set at the first Jacobian.
+        let mut rows: Vec<usize> = Vec::new();
+        let mut coefficients: Vec<usize> = Vec::new();
+        let mut full_size = 0;
         for iteration in 1..=max_iterations {
             if depends_on_s || k_nl.is_none() {
                 let jac = jacobian(s);
@@ -420,22 +457,54 @@ impl Hill {
                 if !nq.is_multiple_of(q) || jac.ncols() != nq || nq == 0 {
                     return Err(StabilityError::JacobianSize { got: nq, expected: q });
                 }
+                let nc = nq / q;
+                if rows.is_empty() {
+                    full_size = m * nc;
+                    // The block alone where the joints' Jacobian keeps the harmonics' parities
+                    // apart (the modal part always does): the exponent's eigenvector lies in
+                    // it, and each step's LU is of half the size, an eighth of the work.
+                    let odd = |i: usize| coefficient_parity(i / q) == 1;
+                    let block = block.filter(|_| half_wave_symmetric(&jac, odd));
+                    coefficients = (0..nc).filter(|&c| block.is_none_or(|p| coefficient_parity(c) == p)).collect();
+                    rows = coefficients.iter().flat_map(|&c| c * m..(c + 1) * m).collect();
+                } else if coefficients.len() < nc && !half_wave_symmetric(&jac, |i| coefficient_parity(i / q) == 1) {
+                    // The parities coupled at another exponent (they do not, for the laws
+                    // that split): the whole problem is the fixed point's to solve.
+                    return Ok(None);
+                }
+                let jac = if coefficients.len() < nc {
+                    let at = |i: usize| coefficients[i / q] * q + i % q;
+                    let n = coefficients.len() * q;
+                    Mat::from_fn(n, n, |i, j| jac[(at(i), at(j))])
+                } else {
+                    jac
+                };
                 k_nl = Some(self.joint_stiffness(jac.as_ref()));
             }
+            let size = rows.len();
+            let harmonics = (full_size / m - 1) / 2;
             let mut t = k_nl.clone().expect("computed above");
-            let size = t.nrows();
-            let harmonics = (size / m - 1) / 2;
-            self.add_modal(omega, s, harmonics, &mut t);
+            if size == full_size {
+                self.add_modal(omega, s, harmonics, &mut t);
+            } else {
+                let mut modal = Mat::<c64>::zeros(full_size, full_size);
+                self.add_modal(omega, s, harmonics, &mut modal);
+                for (b, &j) in rows.iter().enumerate() {
+                    for (a, &i) in rows.iter().enumerate() {
+                        t[(a, b)] += modal[(i, j)];
+                    }
+                }
+            }
             let lu = t.partial_piv_lu();
             let column = |v: &[c64]| Mat::from_fn(v.len(), 1, |i, _| v[i]);
             if x.is_empty() {
-                x = match vector.filter(|v| v.len() == size) {
-                    Some(v) => v.to_vec(),
+                x = match vector.filter(|v| v.len() == full_size) {
+                    Some(v) => rows.iter().map(|&i| v[i]).collect(),
                     None => {
                         // A generic start (no symmetry of the harmonics can make it orthogonal
                         // to the eigenvector), improved by one inverse-iteration step. Real, so
                         // that a real exponent of a real T(s) stays exactly real.
-                        let b = Mat::from_fn(size, 1, |i, _| c64::new(1.0 + 0.37 * (i as f64).sin(), 0.0));
+                        let b = Mat::from_fn(size, 1, |a, _| c64::new(1.0 + 0.37 * (rows[a] as f64).sin(), 0.0));
                         let y = lu.solve(&b);
                         (0..size).map(|i| y[(i, 0)]).collect()
                     }
@@ -447,7 +516,16 @@ impl Hill {
                 x.iter_mut().for_each(|a| *a /= norm);
                 v = x.clone();
             }
-            let u = lu.solve(column(&self.modal_derivative(omega, s, harmonics, &x)));
+            // T'(s) x on the block: the modal derivative keeps the parities apart.
+            let derivative = if size == full_size {
+                self.modal_derivative(omega, s, harmonics, &x)
+            } else {
+                let mut whole = vec![c64::new(0.0, 0.0); full_size];
+                rows.iter().zip(&x).for_each(|(&i, &value)| whole[i] = value);
+                let whole = self.modal_derivative(omega, s, harmonics, &whole);
+                rows.iter().map(|&i| whole[i]).collect()
+            };
+            let u = lu.solve(column(&derivative));
             let vu: c64 = (0..size).map(|i| v[i].conj() * u[(i, 0)]).sum();
             // vᴴx = 1: Newton's step is 1 / vᴴT⁻¹T'x.
             let step = c64::new(1.0, 0.0) / vu;
@@ -457,14 +535,20 @@ impl Hill {
             s -= step;
             x = (0..size).map(|i| u[(i, 0)] / vu).collect();
             let change = step.norm();
+            // Hill's P, the other block's harmonics zero.
+            let whole = |x: &[c64]| {
+                let mut p = vec![c64::new(0.0, 0.0); full_size];
+                rows.iter().zip(x).for_each(|(&i, &value)| p[i] = value);
+                p
+            };
             if change <= CONVERGED * omega {
-                return Ok(Some(Refined { exponent: s, vector: x, iterations: iteration }));
+                return Ok(Some(Refined { exponent: s, vector: whole(&x), iterations: iteration }));
             }
             if iteration > 2 && change >= previous {
                 // Stalled: at round-off if the steps are already tiny, else not converging (a
                 // linear rate near 1, or a jump between roots).
                 let converged = change <= 1e3 * CONVERGED * omega;
-                return Ok(converged.then_some(Refined { exponent: s, vector: x, iterations: iteration }));
+                return Ok(converged.then_some(Refined { exponent: s, vector: whole(&x), iterations: iteration }));
             }
             previous = change;
         }
@@ -493,6 +577,12 @@ impl Hill {
 /// round-off (~1e-16), and dropping 1e-12 of the stiffness moves an exponent by ~1e-12 of its
 /// scale, far below the 1e-9 Ω within which exponents are compared to the imaginary axis.
 const SYMMETRY: f64 = 1e-12;
+
+/// The parity (0 even, 1 odd) of the harmonic of the balance's coefficient `c` (0: the mean,
+/// then the cosine and sine of each harmonic).
+fn coefficient_parity(c: usize) -> usize {
+    c.div_ceil(2) % 2
+}
 
 /// Does `k` (square) couple no index with `odd(i)` to one without, to [`SYMMETRY`]?
 fn half_wave_symmetric(k: &Mat<c64>, odd: impl Fn(usize) -> bool) -> bool {
