@@ -121,6 +121,7 @@ mod linear;
 mod run;
 mod singular;
 
+pub use dense_lu::PivotedLu;
 pub use extremum::{maximise_along, zero_along, Bracket, Extremum};
 pub use run::continue_branch;
 pub use singular::{singular_points, Determinant, SingularKind, SingularPoint, TestFunctions, VariableScales};
