@@ -282,9 +282,9 @@ fn fixed(v: f64, digits: usize) -> String {
 }
 
 /// A stage's time in seconds: to the microsecond below a second (the stages of a small
-/// study take fractions of a millisecond), to the millisecond above.
+/// study take fractions of a millisecond), to 0.1 ms above.
 fn duration(seconds: f64) -> String {
-    fixed(seconds, if seconds < 1.0 { 6 } else { 3 })
+    fixed(seconds, if seconds < 1.0 { 6 } else { 4 })
 }
 
 /// A finite value to 4 significant digits (plain for moderate magnitudes, exponent form
@@ -833,7 +833,7 @@ mod tests {
             stability: false,
             bifurcations: vec![],
             files: files.iter().map(|f| dir.join(f)).collect(),
-            timings: vec![("sweep".into(), 1.23456)],
+            timings: vec![("sweep".into(), 1.23456), ("  located peaks".into(), 0.000612345)],
         }
     }
 
@@ -928,7 +928,8 @@ mod tests {
         // The share of the load each mode takes, beside its frequency.
         assert!(html.contains("<td class=\"num\">238.205</td><td>yes</td><td class=\"num\">0.7500</td>"), "{html}");
         assert!(html.contains("<td class=\"num\">1000</td><td class=\"num\">0</td><td class=\"bad\">"));
-        assert!(html.contains("1.2346"));
+        // Stage times to 0.1 ms above a second, to the microsecond below.
+        assert!(html.contains("1.2346") && html.contains("0.000612"));
         assert!(html.contains("No figures."));
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -258,9 +258,11 @@ impl Workspace {
     /// was of the residual alone (only when [`Self::lazy`]).
     pub fn complete<P: Problem + ?Sized>(&mut self, problem: &mut P) -> Result<(), ProblemError> {
         let n = self.n;
-        self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
         let mut jx = self.matrix.as_mut().submatrix_mut(0, 0, n, n);
-        jx.fill(0.0);
+        if !problem.completion_writes_every_entry() {
+            self.dr_dlambda.iter_mut().for_each(|v| *v = 0.0);
+            jx.fill(0.0);
+        }
         self.holds_jacobian = false;
         self.holds_bordered_factors = false;
         problem.complete_jacobian((jx, &mut self.dr_dlambda))?;

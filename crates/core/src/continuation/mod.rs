@@ -167,11 +167,19 @@ pub trait Problem {
         false
     }
 
-    /// `∂R/∂x` and `∂R/∂λ` (buffers as for [`Self::evaluate`], zeroed) at the point of the last
+    /// `∂R/∂x` and `∂R/∂λ` (buffers as for [`Self::evaluate`], zeroed unless
+    /// [`Self::completion_writes_every_entry`]) at the point of the last
     /// [`Self::evaluate`], which was asked for the residual alone; called only when
     /// [`Self::completes_jacobian`].
     fn complete_jacobian(&mut self, _jacobian: (MatMut<'_, f64>, &mut [f64])) -> Result<(), ProblemError> {
         Err(ProblemError::new("this problem does not complete a residual evaluation to a Jacobian"))
+    }
+
+    /// Does [`Self::complete_jacobian`] write every entry of `∂R/∂x` and `∂R/∂λ`? Then the
+    /// corrector does not zero them before the call (the fill of a 60 × 60 Jacobian is ~2 % of
+    /// a paper-size sweep). Default: no.
+    fn completion_writes_every_entry(&self) -> bool {
+        false
     }
 
     /// `Some(a)` when the last dense `∂R/∂x` written ([`Self::evaluate`] or

@@ -58,6 +58,10 @@ impl Problem for FrequencySweep<'_, '_> {
         completed(self.hbm.complete_jacobian(dx, Some(dl), None))
     }
 
+    fn completion_writes_every_entry(&self) -> bool {
+        true
+    }
+
     fn decoupled_unknowns(&self) -> Option<&[usize]> {
         self.hbm.decoupled_unknowns()
     }
