@@ -23,7 +23,8 @@ use super::singular::Determinant;
 pub struct PivotedLu {
     /// Column-major `size × size`.
     factors: Vec<f64>,
-    /// faer's row permutation (`(P A)_i = A_{perm_i}`) and its inverse.
+    /// The row permutation (`(P A)_i = A_{perm_i}`), and its inverse, which faer's
+    /// factorisation writes too (unused otherwise).
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     /// Size of the last factorisation, and its number of row swaps.
