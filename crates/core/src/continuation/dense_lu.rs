@@ -30,7 +30,7 @@ pub struct PivotedLu {
     /// Size of the last factorisation, and its number of row swaps.
     size: usize,
     swaps: usize,
-    /// faer's workspace, for matrices above [`BY_HAND`] rows.
+    /// faer's workspace, made at the first matrix above [`BY_HAND`] rows.
     scratch: Option<MemBuffer>,
     /// The right-hand side permuted.
     permuted: Vec<f64>,
@@ -46,14 +46,7 @@ impl PivotedLu {
             perm_inv: vec![0; capacity],
             size: 0,
             swaps: 0,
-            scratch: (capacity > BY_HAND).then(|| {
-                MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
-                    capacity,
-                    capacity,
-                    Par::Seq,
-                    Default::default(),
-                ))
-            }),
+            scratch: None,
         }
     }
 
@@ -74,8 +67,10 @@ impl PivotedLu {
             self.swaps = factor_by_pairs(factors, n, &mut self.perm[..n]);
             return;
         }
+        // Made at the first factorisation above BY_HAND rows, for the largest planned.
+        let capacity = self.perm.len();
         let scratch = self.scratch.get_or_insert_with(|| {
-            MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()))
+            MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(capacity, capacity, Par::Seq, Default::default()))
         });
         let (info, _) = factor::lu_in_place(
             MatMut::from_column_major_slice_mut(factors, n, n),

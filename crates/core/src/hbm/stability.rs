@@ -175,12 +175,8 @@ impl Hill {
         jacobian: MatRef<'_, f64>,
     ) -> Result<(Stability, Vec<Option<usize>>), StabilityError> {
         let complex = Mat::from_fn(jacobian.nrows(), jacobian.ncols(), |i, j| c64::new(jacobian[(i, j)], 0.0));
-        let mut all = self.eigenvalues_in_blocks(omega, complex.as_ref())?;
-        // The same order as `physical` (stable sorts on the values alone).
-        all.sort_by(|a, b| a.0.im.abs().total_cmp(&b.0.im.abs()));
-        all.truncate(2 * self.n_modes());
-        all.sort_by(|a, b| b.0.re.total_cmp(&a.0.re).then(b.0.im.total_cmp(&a.0.im)));
-        let (exponents, blocks) = all.into_iter().unzip();
+        let all = self.eigenvalues_in_blocks(omega, complex.as_ref())?;
+        let (exponents, blocks) = self.physical(all).into_iter().unzip();
         Ok((Stability { exponents }, blocks))
     }
 
@@ -344,15 +340,21 @@ impl Hill {
     /// Adds the modal part of Hill's quadratic matrix at `s`, `s² I + s Δ₁ + Δ₀`, to `t`
     /// (harmonic 0: `Δ₀ = Λ`, `Δ₁ = C`; harmonic k: `Δ₀ = (Λ − (kΩ)²) I + C ∇`,
     /// `Δ₁ = C + 2∇`, `∇ (c, s) = kΩ (s, −c)`): 2 × 2 blocks per mode and harmonic, coupled
-    /// between modes by the off-diagonal terms of `C`.
-    fn add_modal(&self, omega: f64, s: c64, harmonics: usize, t: &mut Mat<c64>) {
+    /// between modes by the off-diagonal terms of `C`. `at[c]` is where the balance's
+    /// coefficient `c` lies among `t`'s (`None`: not in `t`, a block of the other parity); the
+    /// part never couples two coefficients of different harmonics.
+    fn add_modal(&self, omega: f64, s: c64, at: &[Option<usize>], t: &mut Mat<c64>) {
         let m = self.n_modes();
+        let harmonics = (at.len() - 1) / 2;
         for r in 0..m {
             let w2 = self.omega_r[r] * self.omega_r[r];
-            t[(r, r)] += s * s + w2;
+            if let Some(c0) = at[0] {
+                t[(c0 * m + r, c0 * m + r)] += s * s + w2;
+            }
             for k in 1..=harmonics {
+                let (Some(c), Some(sn)) = (at[cos_index(k)], at[sin_index(k)]) else { continue };
                 let kw = k as f64 * omega;
-                let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
+                let (ic, is) = (c * m + r, sn * m + r);
                 let diagonal = s * s + (w2 - kw * kw);
                 t[(ic, ic)] += diagonal;
                 t[(is, is)] += diagonal;
@@ -364,10 +366,13 @@ impl Hill {
                 if c == 0.0 {
                     continue;
                 }
-                t[(r, l)] += s * c;
+                if let Some(c0) = at[0] {
+                    t[(c0 * m + r, c0 * m + l)] += s * c;
+                }
                 for k in 1..=harmonics {
+                    let (Some(ck), Some(sk)) = (at[cos_index(k)], at[sin_index(k)]) else { continue };
                     let kw = k as f64 * omega;
-                    let (ic, is) = (cos_index(k) * m, sin_index(k) * m);
+                    let (ic, is) = (ck * m, sk * m);
                     t[(ic + r, ic + l)] += s * c;
                     t[(is + r, is + l)] += s * c;
                     t[(ic + r, is + l)] += c * kw;
@@ -377,15 +382,20 @@ impl Hill {
         }
     }
 
-    /// `(2s I + Δ₁) x`: the derivative of the modal part of Hill's matrix in `s`, applied.
-    fn modal_derivative(&self, omega: f64, s: c64, harmonics: usize, x: &[c64]) -> Vec<c64> {
+    /// `(2s I + Δ₁) x`: the derivative of the modal part of Hill's matrix in `s`, applied, with
+    /// `x` laid out as [`Self::add_modal`]'s `t` by `at`.
+    fn modal_derivative(&self, omega: f64, s: c64, at: &[Option<usize>], x: &[c64]) -> Vec<c64> {
         let m = self.n_modes();
+        let harmonics = (at.len() - 1) / 2;
         let mut y = vec![c64::new(0.0, 0.0); x.len()];
         for r in 0..m {
-            y[r] = s * 2.0 * x[r];
+            if let Some(c0) = at[0] {
+                y[c0 * m + r] = s * 2.0 * x[c0 * m + r];
+            }
             for k in 1..=harmonics {
+                let (Some(c), Some(sn)) = (at[cos_index(k)], at[sin_index(k)]) else { continue };
                 let kw2 = 2.0 * k as f64 * omega;
-                let (ic, is) = (cos_index(k) * m + r, sin_index(k) * m + r);
+                let (ic, is) = (c * m + r, sn * m + r);
                 y[ic] = s * 2.0 * x[ic] + x[is] * kw2;
                 y[is] = s * 2.0 * x[is] - x[ic] * kw2;
             }
@@ -394,11 +404,9 @@ impl Hill {
                 if c == 0.0 {
                     continue;
                 }
-                y[r] += x[l] * c;
-                for k in 1..=harmonics {
-                    let (ic, is) = (cos_index(k) * m, sin_index(k) * m);
-                    y[ic + r] += x[ic + l] * c;
-                    y[is + r] += x[is + l] * c;
+                for coefficient in at.iter().flatten() {
+                    let base = coefficient * m;
+                    y[base + r] += x[base + l] * c;
                 }
             }
         }
@@ -445,11 +453,12 @@ impl Hill {
         let mut k_nl: Option<Mat<c64>> = None;
         let (mut x, mut v): (Vec<c64>, Vec<c64>) = (Vec::new(), Vec::new());
         let mut previous = f64::INFINITY;
-        // The rows of Hill's matrix worked in (its own parity block, or all), and the joints'
-        // Jacobian's coefficients of that parity; set at the first Jacobian.
-        let mut rows: Vec<usize> = Vec::new();
+        // The balance's coefficients worked in (those of its own parity block, or all), and
+        // where each lies in the block (`None`: the other block); set at the first Jacobian.
         let mut coefficients: Vec<usize> = Vec::new();
-        let mut full_size = 0;
+        let mut at: Vec<Option<usize>> = Vec::new();
+        // Hill's rows of those coefficients (all of each one's modes), for `P` as a whole.
+        let mut rows: Vec<usize> = Vec::new();
         for iteration in 1..=max_iterations {
             if depends_on_s || k_nl.is_none() {
                 let jac = jacobian(s);
@@ -458,14 +467,15 @@ impl Hill {
                     return Err(StabilityError::JacobianSize { got: nq, expected: q });
                 }
                 let nc = nq / q;
-                if rows.is_empty() {
-                    full_size = m * nc;
+                if at.is_empty() {
                     // The block alone where the joints' Jacobian keeps the harmonics' parities
                     // apart (the modal part always does): the exponent's eigenvector lies in
                     // it, and each step's LU is of half the size, an eighth of the work.
                     let odd = |i: usize| coefficient_parity(i / q) == 1;
                     let block = block.filter(|_| half_wave_symmetric(&jac, odd));
                     coefficients = (0..nc).filter(|&c| block.is_none_or(|p| coefficient_parity(c) == p)).collect();
+                    at = vec![None; nc];
+                    coefficients.iter().enumerate().for_each(|(local, &c)| at[c] = Some(local));
                     rows = coefficients.iter().flat_map(|&c| c * m..(c + 1) * m).collect();
                 } else if coefficients.len() < nc && !half_wave_symmetric(&jac, |i| coefficient_parity(i / q) == 1) {
                     // The parities coupled at another exponent (they do not, for the laws
@@ -481,20 +491,9 @@ impl Hill {
                 };
                 k_nl = Some(self.joint_stiffness(jac.as_ref()));
             }
-            let size = rows.len();
-            let harmonics = (full_size / m - 1) / 2;
+            let (size, full_size) = (rows.len(), at.len() * m);
             let mut t = k_nl.clone().expect("computed above");
-            if size == full_size {
-                self.add_modal(omega, s, harmonics, &mut t);
-            } else {
-                let mut modal = Mat::<c64>::zeros(full_size, full_size);
-                self.add_modal(omega, s, harmonics, &mut modal);
-                for (b, &j) in rows.iter().enumerate() {
-                    for (a, &i) in rows.iter().enumerate() {
-                        t[(a, b)] += modal[(i, j)];
-                    }
-                }
-            }
+            self.add_modal(omega, s, &at, &mut t);
             let lu = t.partial_piv_lu();
             let column = |v: &[c64]| Mat::from_fn(v.len(), 1, |i, _| v[i]);
             if x.is_empty() {
@@ -517,14 +516,7 @@ impl Hill {
                 v = x.clone();
             }
             // T'(s) x on the block: the modal derivative keeps the parities apart.
-            let derivative = if size == full_size {
-                self.modal_derivative(omega, s, harmonics, &x)
-            } else {
-                let mut whole = vec![c64::new(0.0, 0.0); full_size];
-                rows.iter().zip(&x).for_each(|(&i, &value)| whole[i] = value);
-                let whole = self.modal_derivative(omega, s, harmonics, &whole);
-                rows.iter().map(|&i| whole[i]).collect()
-            };
+            let derivative = self.modal_derivative(omega, s, &at, &x);
             let u = lu.solve(column(&derivative));
             let vu: c64 = (0..size).map(|i| v[i].conj() * u[(i, 0)]).sum();
             // vᴴx = 1: Newton's step is 1 / vᴴT⁻¹T'x.
@@ -562,12 +554,12 @@ impl Hill {
         self
     }
 
-    /// The 2m physical exponents among all the eigenvalues of Hill's problem: the smallest
-    /// |Im s| (Lazarus & Thomas 2010), largest real part first.
-    pub fn physical(&self, mut all: Vec<c64>) -> Vec<c64> {
-        all.sort_by(|a, b| a.im.abs().total_cmp(&b.im.abs()));
+    /// The 2m physical exponents among all the eigenvalues of Hill's problem, each with what
+    /// came with it: the smallest |Im s| (Lazarus & Thomas 2010), largest real part first.
+    fn physical<T>(&self, mut all: Vec<(c64, T)>) -> Vec<(c64, T)> {
+        all.sort_by(|a, b| a.0.im.abs().total_cmp(&b.0.im.abs()));
         all.truncate(2 * self.n_modes());
-        all.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+        all.sort_by(|a, b| b.0.re.total_cmp(&a.0.re).then(b.0.im.total_cmp(&a.0.im)));
         all
     }
 }
