@@ -104,3 +104,81 @@ fn refinement_in_a_parity_block_equals_the_whole() {
     assert!(in_blocks > 300 && compared > 300, "the blocks were used {in_blocks} times, {compared} compared");
     assert!(worst <= 1e-10, "block and whole refinements {worst:.1e} Ω apart");
 }
+
+/// A structure with a repeated exponent: a hub (10 kg, 1e7 N/m to the ground) carrying four
+/// identical blades (1 kg, 2e7 N/m to the hub), each with a Jenkins joint to the ground
+/// (5e6 N/m, 60 N) and D = 20 M, driven at the hub. Three of the blades' modes share one
+/// frequency (the cyclic symmetry's), so the periodic exponents come in repeated triples, as
+/// Harmony's four blades give repeated pairs. Newton's roots for the repeated leading exponents
+/// are now taken (`bifurcation::continues`), and must equal the fixed point's within the same
+/// tolerance, with the same stable flag, at every point through stick and slip.
+#[test]
+fn repeated_exponents_refined_by_newton_equal_the_fixed_point() {
+    use stickslip_core::elements::{Element, Jenkins};
+    use stickslip_core::model::{Damping, DofLabel, ElementSite, LinearModel};
+    let n = 5;
+    let (k_hub, k_blade, k_joint) = (1e7, 2e7, 5e6);
+    let stiffness = common::dense(n, |i, j| match (i, j) {
+        (0, 0) => k_hub + 4.0 * k_blade,
+        (0, _) | (_, 0) => -k_blade,
+        _ if i == j => k_blade + k_joint,
+        _ => 0.0,
+    });
+    let mass = common::dense(n, |i, j| {
+        if i != j {
+            0.0
+        } else if i == 0 {
+            10.0
+        } else {
+            1.0
+        }
+    });
+    let labels = (0..n).map(|i| DofLabel::named(format!("d{i}"))).collect();
+    let linear =
+        LinearModel::new(mass, stiffness, Damping::Rayleigh { alpha: 20.0, beta: 0.0 }, labels, vec![]).unwrap();
+    let blades = (1..n)
+        .map(|b| {
+            let law: Box<dyn Element> = Box::new(Jenkins::replacing_stiffness(k_joint, 60.0).unwrap());
+            let mut direction = vec![0.0; n];
+            direction[b] = 1.0;
+            ElementSite { name: format!("blade{b}"), law, directions: vec![direction] }
+        })
+        .collect();
+    let model = NonlinearModel::new(linear, blades).unwrap();
+    let mut force = vec![0.0; n];
+    force[0] = 1.0;
+    let settings = HbmSettings { harmonics: 5, samples: 256 };
+    // The hub's mode with the blades in phase, near 420 Hz stuck; the repeated blade modes at
+    // 796 Hz are not excited (the response keeps the symmetry) but their exponents lead.
+    // With D = αM every stuck mode's exponents have the real part −α/2: the leading one is
+    // any of them, so the exponents are compared as sets, each with its nearest.
+    let band = (TWO_PI * 300.0, TWO_PI * 550.0);
+    for level in [200.0, 2000.0] {
+        let mut hbm = CondensedHbm::new(&model, &force, settings).unwrap();
+        let branch = sweep_frequency(&mut hbm, level, band.0, band.1, &Options::default(), &mut Silent).unwrap();
+        assert_eq!(branch.termination, TerminationReason::ReachedEnd);
+        assert!(branch.points.len() > 20);
+        let hill = Hill::new(hbm.receptance(), HillSettings::for_band(settings.harmonics, band.1)).unwrap();
+        let whole = hill.clone().without_symmetry();
+        let (mut worst, mut repeated): (f64, usize) = (0.0, 0);
+        for p in &branch.points {
+            let fast = stability_at(&mut hbm, &hill, &p.x, p.lambda).unwrap();
+            let reference = stability_by_eigenproblems(&mut hbm, &whole, &p.x, p.lambda).unwrap();
+            assert_eq!(is_stable(&fast, p.lambda), is_stable(&reference, p.lambda), "Ω = {}", p.lambda);
+            let (a, b) = (fast.leading(), reference.leading());
+            assert!((a.re - b.re).abs() <= TOLERANCE * p.lambda, "Ω = {}: leading {a}, reference {b}", p.lambda);
+            for s in &fast.exponents {
+                let nearest = reference.exponents.iter().map(|r| (r - s).norm()).fold(f64::INFINITY, f64::min);
+                worst = worst.max(nearest / p.lambda);
+                let copies = fast.exponents.iter().filter(|r| (*r - s).norm() <= 1e-9 * p.lambda).count();
+                repeated += usize::from(copies > 1);
+            }
+        }
+        eprintln!(
+            "{level} N: {} points, worst difference {worst:.1e} Ω, {repeated} repeated exponents",
+            branch.points.len()
+        );
+        assert!(worst <= TOLERANCE, "exponents {worst:.1e} Ω from the reference's");
+        assert!(repeated > 0, "no repeated exponent: the test does not test what it says");
+    }
+}

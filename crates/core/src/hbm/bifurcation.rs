@@ -151,8 +151,6 @@ fn refined_stability(
     let periodic = stability.exponents.clone();
     for i in leading {
         let start = periodic[i];
-        let nearest = (0..periodic.len()).filter(|&j| j != i).map(|j| (periodic[j] - start).norm());
-        let nearest = nearest.fold(f64::INFINITY, f64::min);
         let newton = match reference {
             true => None,
             false => hill
@@ -160,7 +158,7 @@ fn refined_stability(
                     hbm.delayed_force_jacobian(omega, s)
                 })?
                 .map(|r| r.exponent)
-                .filter(|s| (s - start).norm() <= CLOSE_ROOT * nearest.min(omega)),
+                .filter(|&root| continues(start, root, &periodic, omega)),
         };
         let s = match newton {
             Some(s) => s,
@@ -219,6 +217,24 @@ const MEMORY_ITERATIONS: usize = 50;
 /// −2.8e4 1/s): the fixed point's result is kept there too. The test `stability_newton` checks
 /// the outcome against the fixed point everywhere.
 pub const CLOSE_ROOT: f64 = 0.25;
+
+/// Exponents within this of each other, relative to Ω, are one exponent repeated, not two: a
+/// symmetry of the structure repeats them to round-off (Harmony's four blades: pairs 1e-11 Ω
+/// apart), where exponents that coalesce along a branch come no closer than the continuation's
+/// steps bring them (1e-3 Ω and more).
+pub const REPEATED: f64 = 1e-9;
+
+/// Is Newton's `root`, from the periodic exponent `start` (one of `periodic`), the exponent
+/// that continues `start` with the sliders' memory? It must lie within [`CLOSE_ROOT`] of the
+/// distance from `start` to the nearest other exponent (Ω at most), the copies of a repeated
+/// `start` ([`REPEATED`]) not counted: their roots are its own. Counting them sent every
+/// leading exponent of Harmony, a pair 1e-11 Ω apart, to the fixed point: a second per point,
+/// for the roots Newton had found (the same within 1e-8 1/s).
+pub fn continues(start: c64, root: c64, periodic: &[c64], omega: f64) -> bool {
+    let distinct = periodic.iter().map(|p| (p - start).norm()).filter(|&d| d > REPEATED * omega);
+    let nearest = distinct.fold(f64::INFINITY, f64::min);
+    (root - start).norm() <= CLOSE_ROOT * nearest.min(omega)
+}
 
 /// Is the solution with these exponents stable at Ω?
 pub fn is_stable(stability: &Stability, omega: f64) -> bool {
@@ -442,3 +458,28 @@ const CROSSED: f64 = 1e-6;
 /// through −1) count as those: the exponents are accurate to ~1e-12 Ω (Hill's eigenproblem),
 /// ~1e-9 Ω with the sliders' memory refined.
 const REAL: f64 = 1e-6;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Newton's root continues its start within a quarter of the distance to the nearest other
+    /// exponent; a copy of the start 1e-11 Ω away (a repeated exponent) does not count, another
+    /// exponent 4 1/s away does.
+    #[test]
+    fn a_repeated_exponent_does_not_shrink_the_trust_radius() {
+        let omega = 1500.0;
+        let start = c64::new(-7.5, 514.42);
+        let copy = start + c64::new(0.0, 1e-11 * omega);
+        let other = start + c64::new(0.0, 4.0);
+        let periodic = [start, copy, other, start.conj(), copy.conj()];
+        assert!(continues(start, start + c64::new(-0.9, 0.3), &periodic, omega));
+        assert!(!continues(start, start + c64::new(-1.0, 0.3), &periodic, omega));
+        // Without the other exponent, the radius is a quarter of the distance to the conjugates.
+        let alone = [start, copy, start.conj(), copy.conj()];
+        assert!(continues(start, start + c64::new(-3.0, 0.0), &alone, omega));
+        // Copies further apart than `REPEATED` are two exponents.
+        let apart = [start, start + c64::new(0.0, 1e-6 * omega)];
+        assert!(!continues(start, start + c64::new(-1e-3, 0.0), &apart, omega));
+    }
+}
