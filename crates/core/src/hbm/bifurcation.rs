@@ -162,7 +162,7 @@ fn refined_stability(
         };
         let s = match newton {
             Some(s) => s,
-            None => fixed_point(hbm, hill, omega, start)?,
+            None => fixed_point(hbm, hill, omega, start, blocks[i])?,
         };
         // Its conjugate (the same perturbation, real) follows.
         if let Some(j) = (0..periodic.len())
@@ -181,12 +181,21 @@ fn refined_stability(
 /// The exponent near `start` with the sliders' memory, by the fixed point
 /// `s ← the eigenvalue of Hill(J(s)) nearest s`, one dense complex eigenproblem a step. It
 /// converges fast (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
-fn fixed_point(hbm: &CondensedHbm<'_>, hill: &Hill, omega: f64, start: c64) -> Result<c64, BranchStabilityError> {
+/// In `start`'s parity block of Hill's matrix where it splits (`block`, from
+/// [`Hill::exponents_in_blocks`]): half the size, and no jump to an exponent of the other
+/// parity's perturbations.
+fn fixed_point(
+    hbm: &CondensedHbm<'_>,
+    hill: &Hill,
+    omega: f64,
+    start: c64,
+    block: Option<usize>,
+) -> Result<c64, BranchStabilityError> {
     let mut s = start;
     let mut previous_change = f64::INFINITY;
     for _ in 0..MEMORY_ITERATIONS {
         let jac = hbm.delayed_force_jacobian(omega, s);
-        let all = hill.eigenvalues(omega, jac.as_ref())?;
+        let all = hill.eigenvalues_of_block(omega, jac.as_ref(), block)?;
         let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
         let change = (next - s).norm();
         s = next;

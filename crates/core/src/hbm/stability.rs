@@ -175,7 +175,7 @@ impl Hill {
         jacobian: MatRef<'_, f64>,
     ) -> Result<(Stability, Vec<Option<usize>>), StabilityError> {
         let complex = Mat::from_fn(jacobian.nrows(), jacobian.ncols(), |i, j| c64::new(jacobian[(i, j)], 0.0));
-        let all = self.eigenvalues_in_blocks(omega, complex.as_ref())?;
+        let all = self.eigenvalues_in_blocks(omega, complex.as_ref(), None)?;
         let (exponents, blocks) = self.physical(all).into_iter().unzip();
         Ok((Stability { exponents }, blocks))
     }
@@ -183,14 +183,29 @@ impl Hill {
     /// Every eigenvalue of Hill's problem with the joints' Jacobian `jacobian` (complex when
     /// it depends on the exponent: [`super::CondensedHbm::delayed_force_jacobian`]).
     pub fn eigenvalues(&self, omega: f64, jacobian: MatRef<'_, c64>) -> Result<Vec<c64>, StabilityError> {
-        Ok(self.eigenvalues_in_blocks(omega, jacobian)?.into_iter().map(|(s, _)| s).collect())
+        self.eigenvalues_of_block(omega, jacobian, None)
     }
 
-    /// [`Self::eigenvalues`], each with the parity block it came from (`None`: not split).
+    /// [`Self::eigenvalues`] of the parity block `block` (0 even, 1 odd harmonics) where
+    /// Hill's matrix splits into two ([`Self::exponents_in_blocks`]), every one where it does
+    /// not or `block` is `None`: an exponent's eigenvector stays in its block, so the
+    /// exponents that continue it are there, for one eigenproblem of half the size.
+    pub fn eigenvalues_of_block(
+        &self,
+        omega: f64,
+        jacobian: MatRef<'_, c64>,
+        block: Option<usize>,
+    ) -> Result<Vec<c64>, StabilityError> {
+        Ok(self.eigenvalues_in_blocks(omega, jacobian, block)?.into_iter().map(|(s, _)| s).collect())
+    }
+
+    /// The eigenvalues of the parity block `only`, or of both (`None`), each with the block it
+    /// came from (`None`: not split).
     fn eigenvalues_in_blocks(
         &self,
         omega: f64,
         jacobian: MatRef<'_, c64>,
+        only: Option<usize>,
     ) -> Result<Vec<(c64, Option<usize>)>, StabilityError> {
         let q = self.a.nrows();
         let m = self.n_modes();
@@ -275,7 +290,7 @@ impl Hill {
         // sliders' memory keeps the symmetry: a stick phase and its mirror half a period later
         // have the same delay.
         let mut all = Vec::with_capacity(2 * size);
-        for p in 0..2 {
+        for p in (0..2).filter(|&p| only.is_none_or(|only| only == p)) {
             let block: Vec<usize> = (0..2 * size).filter(|&i| parity(i) == p).collect();
             let block = Mat::from_fn(block.len(), block.len(), |a, b| companion[(block[a], block[b])]);
             all.extend(solve(block)?.into_iter().map(|s| (s, Some(p))));
