@@ -30,7 +30,7 @@
 use faer::{c64, Mat};
 
 use super::condensed::{CondensedHbm, HbmError};
-use super::stability::{Hill, Stability, StabilityError};
+use super::stability::{nearer, Hill, Stability, StabilityError};
 use super::sweep::FrequencySweep;
 use crate::continuation::{singular_points, zero_along, Point, Problem, ProblemError, SingularKind, TestFunctions};
 
@@ -162,7 +162,7 @@ fn refined_stability(
         };
         let s = match newton {
             Some(s) => s,
-            None => fixed_point(hbm, hill, omega, start, blocks[i])?,
+            None => fixed_point(hbm, hill, omega, start, blocks[i], !reference)?,
         };
         // Its conjugate (the same perturbation, real) follows.
         if let Some(j) = (0..periodic.len())
@@ -183,20 +183,29 @@ fn refined_stability(
 /// converges fast (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
 /// In `start`'s parity block of Hill's matrix where it splits (`block`, from
 /// [`Hill::exponents_in_blocks`]): half the size, and no jump to an exponent of the other
-/// parity's perturbations.
+/// parity's perturbations. With `locally`, each step's nearest eigenvalue comes from inverse
+/// subspace iteration ([`Hill::nearest_eigenvalue`]), the whole spectrum only where that has
+/// not converged; the reference takes the whole spectrum at every step.
 fn fixed_point(
     hbm: &CondensedHbm<'_>,
     hill: &Hill,
     omega: f64,
     start: c64,
     block: Option<usize>,
+    locally: bool,
 ) -> Result<c64, BranchStabilityError> {
     let mut s = start;
     let mut previous_change = f64::INFINITY;
     for _ in 0..MEMORY_ITERATIONS {
         let jac = hbm.delayed_force_jacobian(omega, s);
-        let all = hill.eigenvalues_of_block(omega, jac.as_ref(), block)?;
-        let next = all.iter().copied().min_by(|a, b| (a - s).norm().total_cmp(&(b - s).norm())).unwrap_or(s);
+        let local = if locally { hill.nearest_eigenvalue(omega, jac.as_ref(), block, s)? } else { None };
+        let next = match local {
+            Some(next) => next,
+            None => {
+                let all = hill.eigenvalues_of_block(omega, jac.as_ref(), block)?;
+                all.iter().copied().min_by(|&a, &b| nearer(a, b, s)).unwrap_or(s)
+            }
+        };
         let change = (next - s).norm();
         s = next;
         // Converged, or down to the eigensolver's round-off (~1e-10 of the matrix's

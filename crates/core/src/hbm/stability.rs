@@ -207,6 +207,103 @@ impl Hill {
         jacobian: MatRef<'_, c64>,
         only: Option<usize>,
     ) -> Result<Vec<(c64, Option<usize>)>, StabilityError> {
+        let mut all = Vec::new();
+        for (mut matrix, block) in self.companion_blocks(omega, jacobian, only)? {
+            let n = matrix.nrows();
+            let failed = StabilityError::Eigen { size: n };
+            // A real Hill matrix (a periodic Jacobian) is solved as such: half the work.
+            let eigenvalues = if matrix.col_iter().all(|col| col.iter().all(|v| v.im == 0.0)) {
+                let mut real = Mat::from_fn(n, n, |i, j| matrix[(i, j)].re);
+                balance(&mut real, |v| v * v);
+                real_eigenvalues(real).ok_or_else(|| failed.clone())?
+            } else {
+                balance(&mut matrix, |v| v.norm_sqr());
+                matrix.eigenvalues().map_err(|_| failed.clone())?
+            };
+            if eigenvalues.iter().any(|s| !s.re.is_finite() || !s.im.is_finite()) {
+                return Err(failed);
+            }
+            all.extend(eigenvalues.into_iter().map(|s| (s, block)));
+        }
+        Ok(all)
+    }
+
+    /// The eigenvalue of Hill's problem nearest `s`, in the parity block `block` where the
+    /// matrix splits (both blocks where it does not or `block` is `None`), by inverse subspace
+    /// iteration on the balanced companion matrix shifted by `s`: one complex LU and a few
+    /// solves, where the whole spectrum is a complex Schur form, about ten LUs' work
+    /// (Saad, *Numerical Methods for Large Eigenvalue Problems*, 2011, §5.1). `None` where the
+    /// nearest Ritz pair has not converged (backward error 1e-12 of the matrix's norm) within
+    /// [`SUBSPACE_STEPS`] steps: the caller then takes the whole spectrum.
+    pub fn nearest_eigenvalue(
+        &self,
+        omega: f64,
+        jacobian: MatRef<'_, c64>,
+        block: Option<usize>,
+        s: c64,
+    ) -> Result<Option<c64>, StabilityError> {
+        use faer::linalg::solvers::Solve;
+        let mut nearest: Option<c64> = None;
+        for (mut matrix, _) in self.companion_blocks(omega, jacobian, block)? {
+            balance(&mut matrix, |v| v.norm_sqr());
+            let n = matrix.nrows();
+            let norm = matrix.norm_l2();
+            let p = SUBSPACE_SIZE.min(n);
+            let mut shifted = matrix.clone();
+            for i in 0..n {
+                shifted[(i, i)] -= s;
+            }
+            let lu = shifted.partial_piv_lu();
+            // A generic start: no symmetry of the harmonics can make it orthogonal to an
+            // eigenvector.
+            let mut basis = Mat::from_fn(n, p, |i, j| {
+                let t = (i * (j + 1)) as f64;
+                c64::new(1.0 + 0.37 * t.sin(), 0.23 * (0.7 * t + j as f64).cos())
+            });
+            let mut found = None;
+            for _ in 0..SUBSPACE_STEPS {
+                let next = lu.solve(&basis);
+                if !next.col_iter().all(|c| c.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
+                    break;
+                }
+                basis = next.qr().compute_thin_Q();
+                let image = &matrix * &basis;
+                let projected = basis.adjoint() * &image;
+                let Ok(eigen) = projected.eigen() else { break };
+                let (values, vectors) = (eigen.S(), eigen.U());
+                let k = (0..p).min_by(|&a, &b| nearer(values[a], values[b], s));
+                let Some(k) = k else { break };
+                let (theta, y) = (values[k], vectors.col(k));
+                let x = &basis * y;
+                let residual = &image * y - &x * faer::Scale(theta);
+                if residual.norm_l2() <= SUBSPACE_TOLERANCE * norm * x.norm_l2() {
+                    found = Some(theta);
+                    break;
+                }
+            }
+            let Some(mut theta) = found else { return Ok(None) };
+            // A real matrix about a real shift has its conjugate as near: the one above the
+            // axis, as [`nearer`] orders them (the Ritz values are conjugate only to their
+            // convergence, not to the tie's round-off).
+            if s.im == 0.0 && theta.im < 0.0 && matrix.col_iter().all(|c| c.iter().all(|v| v.im == 0.0)) {
+                theta = theta.conj();
+            }
+            if nearest.is_none_or(|best| nearer(theta, best, s).is_lt()) {
+                nearest = Some(theta);
+            }
+        }
+        Ok(nearest)
+    }
+
+    /// Hill's companion matrix at Ω with the joints' Jacobian `jacobian`: its parity block
+    /// `only` where it splits into even and odd harmonics (both for `None`), else the whole
+    /// matrix, each with its block's parity (`None`: not split).
+    fn companion_blocks(
+        &self,
+        omega: f64,
+        jacobian: MatRef<'_, c64>,
+        only: Option<usize>,
+    ) -> Result<Vec<ParityBlock>, StabilityError> {
         let q = self.a.nrows();
         let m = self.n_modes();
         let nq = jacobian.nrows();
@@ -258,27 +355,10 @@ impl Hill {
                 }
             }
         }
-        let failed = StabilityError::Eigen { size: 2 * size };
-        let solve = |mut matrix: Mat<c64>| -> Result<Vec<c64>, StabilityError> {
-            let n = matrix.nrows();
-            // A real Hill matrix (a periodic Jacobian) is solved as such: half the work.
-            let all = if matrix.col_iter().all(|col| col.iter().all(|v| v.im == 0.0)) {
-                let mut real = Mat::from_fn(n, n, |i, j| matrix[(i, j)].re);
-                balance(&mut real, |v| v * v);
-                real_eigenvalues(real).ok_or_else(|| failed.clone())?
-            } else {
-                balance(&mut matrix, |v| v.norm_sqr());
-                matrix.eigenvalues().map_err(|_| failed.clone())?
-            };
-            if all.iter().any(|s| !s.re.is_finite() || !s.im.is_finite()) {
-                return Err(failed.clone());
-            }
-            Ok(all)
-        };
         // Parity of the harmonic of companion row/column i.
         let parity = |i: usize| coefficient_parity((i % size) / m);
         if !(self.split_parity && half_wave_symmetric(&k_nl, |i| parity(i) == 1)) {
-            return Ok(solve(companion)?.into_iter().map(|s| (s, None)).collect());
+            return Ok(vec![(companion, None)]);
         }
         // Half-wave symmetry (x(t + T/2) = −x(t): an odd law, such as a Jenkins slider or a
         // cubic spring, driven at the fundamental without a static load) leaves only odd
@@ -289,13 +369,11 @@ impl Hill {
         // the cost (two eigenproblems of about half the size: 2 (n/2)³ against n³). The
         // sliders' memory keeps the symmetry: a stick phase and its mirror half a period later
         // have the same delay.
-        let mut all = Vec::with_capacity(2 * size);
-        for p in (0..2).filter(|&p| only.is_none_or(|only| only == p)) {
+        let blocks = (0..2).filter(|&p| only.is_none_or(|only| only == p)).map(|p| {
             let block: Vec<usize> = (0..2 * size).filter(|&i| parity(i) == p).collect();
-            let block = Mat::from_fn(block.len(), block.len(), |a, b| companion[(block[a], block[b])]);
-            all.extend(solve(block)?.into_iter().map(|s| (s, Some(p))));
-        }
-        Ok(all)
+            (Mat::from_fn(block.len(), block.len(), |a, b| companion[(block[a], block[b])]), Some(p))
+        });
+        Ok(blocks.collect())
     }
 
     /// `K_nl = Aᵀ J (I + R J)⁻¹ A` per coefficient pair (size m(2N+1), mode-wide and
@@ -633,6 +711,33 @@ fn balance<T: Copy + std::ops::MulAssign<f64>>(a: &mut Mat<T>, abs2: impl Fn(T) 
         }
     }
 }
+
+/// A block of Hill's companion matrix and the parity of its harmonics (`None`: the whole).
+type ParityBlock = (Mat<c64>, Option<usize>);
+
+/// Orders `a` before `b` if it lies nearer `s`; at the same distance to round-off (a
+/// conjugate pair about a real `s`, which a real Hill matrix offers), the one above the real
+/// axis first, so that either way of finding the nearest takes the same.
+pub fn nearer(a: c64, b: c64, s: c64) -> std::cmp::Ordering {
+    let (da, db) = ((a - s).norm(), (b - s).norm());
+    if (da - db).abs() <= 1e-12 * da.max(db) {
+        b.im.total_cmp(&a.im)
+    } else {
+        da.total_cmp(&db)
+    }
+}
+
+/// Vectors of the inverse subspace iteration of [`Hill::nearest_eigenvalue`]: more than the
+/// two copies of a repeated exponent (Harmony's blades), so that the nearest converges at the
+/// rate of the fifth nearest.
+const SUBSPACE_SIZE: usize = 4;
+/// Its steps at most: from a fixed point's iterate, a step or two of the distance to the
+/// nearest eigenvalue apart, it converges in a few.
+const SUBSPACE_STEPS: usize = 12;
+/// Its convergence: the nearest Ritz pair's residual against the matrix's norm (a backward
+/// error near the Schur form's ~1e-15 ‖A‖ would cost more steps than the fixed point needs:
+/// its iterates are compared to 1e-10 Ω).
+const SUBSPACE_TOLERANCE: f64 = 1e-12;
 
 /// Rows up to which faer's unblocked double-shift QR finds the eigenvalues instead of its
 /// multishift QR with aggressive early deflation (faer's threshold is 75). Measured on random
