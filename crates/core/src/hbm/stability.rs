@@ -667,7 +667,7 @@ impl Hill {
 const SYMMETRY: f64 = 1e-12;
 
 /// Scale `a` to `D⁻¹ a D`, `D` diagonal of powers of two, so that each row and column of the
-/// same index have 2-norms within a factor of two: the balancing of LAPACK's `dgebal` (Parlett &
+/// same index have 2-norms within a small factor (about 2): the balancing of LAPACK's `dgebal` (Parlett &
 /// Reinsch 1969), without its permutations. The eigenvalues are those of `a` (powers of two
 /// scale exactly); the Schur form's error, ε times the norm, falls with the norm. Written here
 /// because faer 0.24 does not balance before its Schur forms, and Hill's companion matrix needs
@@ -681,6 +681,9 @@ fn balance<T: Copy + std::ops::MulAssign<f64>>(a: &mut Mat<T>, abs2: impl Fn(T) 
     const GAIN: f64 = 0.95;
     /// Sweeps over the rows: LAPACK's converges in a few; a bound keeps any input finite.
     const MAX_SWEEPS: usize = 64;
+    // The norms are sums of squares: finite and non-zero, they lie within ~1e±154, so the
+    // scale f ~ √(r/c) stays within ~2^±512, finite (LAPACK's bounds from the safe minimum are
+    // for its overflow-free norms).
     let n = a.nrows();
     for _ in 0..MAX_SWEEPS {
         let mut scaled = false;
@@ -828,9 +831,18 @@ mod tests {
         }
     }
 
-    /// A non-finite entry leaves its row and column as they are, and the sweeps end.
+    /// A non-finite entry leaves its row and column as they are, and the sweeps end; entries
+    /// 1e300 apart are balanced to within a factor 4, finite (eigenvalues ±1).
     #[test]
-    fn balancing_stops_on_non_finite_entries() {
+    fn balancing_stops_on_non_finite_entries_and_evens_extremes() {
+        let mut b = Mat::from_fn(2, 2, |i, j| match (i, j) {
+            (0, 1) => 1e150,
+            (1, 0) => 1e-150,
+            _ => 0.0,
+        });
+        balance(&mut b, |v| v * v);
+        let ratio = b[(0, 1)] / b[(1, 0)];
+        assert!((0.25..=4.0).contains(&ratio) && b[(0, 1)] * b[(1, 0)] == 1.0, "{b:?}");
         let mut a =
             Mat::from_fn(3, 3, |i, j| if (i, j) == (1, 2) { f64::NAN } else { 1e6_f64.powi(i as i32 - j as i32) });
         balance(&mut a, |v| v * v);
