@@ -94,10 +94,12 @@ pub const EXPONENT_TOLERANCE: f64 = 1e-9;
 /// also sorts out the physical exponents) start Newton's method on the nonlinear Hill problem
 /// `T(s) P = 0` for the leading ones ([`Hill::refine`]: one complex LU of size m(2N+1) per
 /// step). The fixed point `s ← the eigenvalue of Hill(J(s)) nearest s` that it replaces (a
-/// complex eigenproblem of size 2m(2N+1) per step, tens of LUs' worth) remains where Newton's
-/// root lies far from its start ([`CLOSE_ROOT`]): there the nonlinear problem has several
-/// roots, and the fixed point's "nearest eigenvalue" rule picks which; Newton might settle on
-/// another. [`stability_by_eigenproblems`] is the fixed point everywhere, the reference.
+/// complex eigenproblem of size 2m(2N+1) per step, tens of LUs' worth; here in the start's
+/// parity block, by inverse subspace iteration) remains where Newton's root lies far from its
+/// start ([`continues`]): there the nonlinear problem has several roots, and the fixed point's
+/// "nearest eigenvalue" rule picks which; Newton might settle on another.
+/// [`stability_by_eigenproblems`] is the fixed point on the whole spectrum everywhere, the
+/// reference.
 pub fn stability_at(
     hbm: &mut CondensedHbm<'_>,
     hill: &Hill,
@@ -179,7 +181,7 @@ fn refined_stability(
 }
 
 /// The exponent near `start` with the sliders' memory, by the fixed point
-/// `s ← the eigenvalue of Hill(J(s)) nearest s`, one dense complex eigenproblem a step. It
+/// `s ← the eigenvalue of Hill(J(s)) nearest s`, one complex eigenproblem a step. It
 /// converges fast (|s| Δ is a fraction of a radian: a stick phase is shorter than a period).
 /// In `start`'s parity block of Hill's matrix where it splits (`block`, from
 /// [`Hill::exponents_in_blocks`]): half the size, and no jump to an exponent of the other
