@@ -234,7 +234,7 @@ impl Hill {
     /// solves, where the whole spectrum is a complex Schur form, about ten LUs' work
     /// (Saad, *Numerical Methods for Large Eigenvalue Problems*, 2011, §5.1). `None` where the
     /// nearest Ritz pair has not converged (backward error 1e-12 of the matrix's norm) within
-    /// [`SUBSPACE_STEPS`] steps: the caller then takes the whole spectrum.
+    /// `SUBSPACE_STEPS` (12) steps: the caller then takes the whole spectrum.
     pub fn nearest_eigenvalue(
         &self,
         omega: f64,

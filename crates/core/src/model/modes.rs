@@ -74,7 +74,7 @@ impl LinearModel {
 /// residual of 0.44 on a 144-DOF hex20 cantilever, a negative eigenvalue of the positive
 /// definite `L⁻¹ K L⁻ᵀ` of the 627-DOF example blade, `‖S u − θ u‖ / |θ|` of 4e-6 on the
 /// Rayleigh-Ritz matrices of the block Lanczos (which stalled its thick restarts). The QR
-/// algorithm, tried first up to [`QR_UP_TO`] rows, gives 5e-15 on the chain. When the check
+/// algorithm, tried first up to `QR_UP_TO` (256) rows, gives 5e-15 on the chain. When the check
 /// fails the pairs are recomputed by divide and conquer (up to that size), then from the SVD: for symmetric S,
 /// `S = U Σ Vᵀ` with `v_i = ±u_i`, the eigenvalue being `σ_i (u_i · v_i)`.
 pub fn symmetric_eigen(s: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
