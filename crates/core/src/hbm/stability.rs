@@ -75,6 +75,13 @@ impl HillSettings {
     }
 }
 
+/// Real parts of Floquet exponents within this fraction of the exponents' largest |Im s|
+/// (~Ω/2) count as equal when choosing the leading one ([`Stability::leading`]). Hill's
+/// exponents agree with the reference's to ~3e-11 Ω (`stability_newton.rs`): a tie a few
+/// hundred times wider than their round-off, and far below any difference of damping a user
+/// tells apart.
+pub const LEADING_TIE: f64 = 1e-8;
+
 /// Why stability cannot be computed.
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum StabilityError {
@@ -94,14 +101,30 @@ pub struct Stability {
 impl Stability {
     /// The exponent with the largest real part: it decides stability and, with its imaginary
     /// part, the kind of a bifurcation when it crosses zero (real: fold or branch point;
-    /// complex pair: Neimark-Sacker).
+    /// complex pair: Neimark-Sacker). Real parts within [`LEADING_TIE`] times the exponents'
+    /// largest |Im s| (at most Ω/2: the physical exponents lie in that strip) of the largest
+    /// count as equal, and of those the one with the smallest |Im s| leads (of a conjugate
+    /// pair, Im s ≥ 0): with mass-proportional damping every stuck mode decays at the same
+    /// −α/2, and round-off alone would otherwise choose among them, so that the imaginary part
+    /// written for a point could change from one run or build to the next.
     pub fn leading(&self) -> c64 {
-        self.exponents.first().copied().unwrap_or(c64::new(f64::NEG_INFINITY, 0.0))
+        let Some(first) = self.exponents.first() else { return c64::new(f64::NEG_INFINITY, 0.0) };
+        let largest_re = self.exponents.iter().fold(first.re, |m, s| m.max(s.re));
+        let tie = LEADING_TIE * self.exponents.iter().fold(0.0f64, |m, s| m.max(s.im.abs()));
+        let smaller = |a: &c64, b: &c64| a.im.abs() < b.im.abs() || (a.im.abs() == b.im.abs() && a.im > b.im);
+        self.exponents
+            .iter()
+            .filter(|s| s.re >= largest_re - tie)
+            .fold(None::<c64>, |best, s| match best {
+                Some(b) if !smaller(s, &b) => Some(b),
+                _ => Some(*s),
+            })
+            .unwrap_or(*first)
     }
 
     /// Stable when every exponent has a negative real part, up to `tolerance` (1/s).
     pub fn is_stable(&self, tolerance: f64) -> bool {
-        self.leading().re <= tolerance
+        self.exponents.iter().all(|s| s.re <= tolerance)
     }
 
     /// Floquet multipliers `e^{sT}` at fundamental `omega` (rad/s).
@@ -790,6 +813,34 @@ fn half_wave_symmetric(k: &Mat<c64>, odd: impl Fn(usize) -> bool) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Stuck modes with mass-proportional damping share the real part −α/2 up to round-off:
+    /// the leading exponent is the one of smallest |Im s| among them, its upper conjugate,
+    /// whatever the order and the round-off (here 1e-12 1/s, against a tie of 1e-8 × 700).
+    /// An exponent less damped by more than the tie (7e-6 1/s: here 5e-5) leads alone. The stable flag
+    /// reads every real part.
+    #[test]
+    fn the_leading_exponent_of_a_tie_is_the_smallest_imaginary_part() {
+        let tied = [
+            c64::new(-7.5 + 1e-12, 700.0),
+            c64::new(-7.5 + 1e-12, -700.0),
+            c64::new(-7.5, -310.0),
+            c64::new(-7.5 - 1e-12, 310.0),
+            c64::new(-7.5 + 5e-13, 512.0),
+            c64::new(-3e4, 0.0),
+        ];
+        for shift in 0..tied.len() {
+            let mut exponents = tied.to_vec();
+            exponents.rotate_left(shift);
+            let leading = Stability { exponents: exponents.clone() }.leading();
+            assert_eq!(leading, c64::new(-7.5 - 1e-12, 310.0), "order {exponents:?}");
+            exponents.push(c64::new(-7.5 + 5e-5, 650.0));
+            assert_eq!(Stability { exponents }.leading(), c64::new(-7.5 + 5e-5, 650.0));
+        }
+        let stability = Stability { exponents: vec![c64::new(-1.0, 2.0), c64::new(1e-3, 0.0)] };
+        assert!(!stability.is_stable(1e-6) && stability.is_stable(2e-3));
+        assert_eq!(Stability { exponents: vec![] }.leading().re, f64::NEG_INFINITY);
+    }
 
     /// Balancing keeps the eigenvalues and evens the norms. The companion form of three
     /// uncoupled modes (1e2, 1e4 and 3e4 rad/s, damping ratios 1 %, 5 %, 0.1 %) has entries from
