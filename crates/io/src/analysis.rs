@@ -370,6 +370,13 @@ impl Problem for FrequencyProblem<'_, '_> {
             FrequencyProblem::Dlft(p) => p.decoupled_unknowns(),
         }
     }
+
+    fn decoupled_block_is_identity(&self) -> bool {
+        match self {
+            FrequencyProblem::Penalty(p) => p.decoupled_block_is_identity(),
+            FrequencyProblem::Dlft(p) => p.decoupled_block_is_identity(),
+        }
+    }
 }
 
 impl<'a> LevelSweeper<'a> {

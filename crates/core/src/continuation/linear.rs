@@ -54,11 +54,17 @@ pub(super) struct Workspace {
 /// `S = [c_x J_b  c_λ r_b; t_bᵀ  t_λ − t_aᵀ w]`, and `det B = det(c_x J_a) det S` (the blocks
 /// are a symmetric permutation of `B`, which keeps its determinant). The first block is the
 /// one away from the branch's folds (the even harmonics of a symmetric response, which it
-/// does not move): `J_b`, singular at a fold, is never inverted alone there.
+/// does not move): `J_b`, singular at a fold, is never inverted alone there. Where `J_a` is the
+/// identity (unknowns the problem pins, [`Problem::decoupled_block_is_identity`]), it is
+/// neither gathered nor factored: its solves divide by `c_x`.
 struct Split {
     a: Vec<usize>,
     b: Vec<usize>,
-    /// `c_x J_a`, factored.
+    /// `J_a` of the last Jacobian is the identity.
+    identity: bool,
+    /// `c_x` of the last factorisation.
+    cx: f64,
+    /// `c_x J_a`, factored (unless `identity`).
     first: PivotedLu,
     /// `S` of the bordered system (size `|b| + 1`), or `c_x J_b` at fixed λ, factored.
     second: PivotedLu,
@@ -75,6 +81,8 @@ impl Split {
         let b: Vec<usize> = (0..n).filter(|i| a.binary_search(i).is_err()).collect();
         let (na, nb) = (a.len(), b.len());
         Split {
+            identity: false,
+            cx: 1.0,
             first: PivotedLu::new(na),
             second: PivotedLu::new(nb + 1),
             w: vec![0.0; na],
@@ -89,15 +97,19 @@ impl Split {
     /// Factor the blocks of `c_x J` (in `jacobian`, n × n) for the bordered system with
     /// column `c_λ r` and row `t`.
     fn factor_bordered(&mut self, jacobian: MatRef<'_, f64>, cx: f64, border: &[f64], t: &[f64]) {
-        let (a, b) = (&self.a, &self.b);
-        let nb = b.len();
-        self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
-        for (k, &i) in a.iter().enumerate() {
+        let nb = self.b.len();
+        self.cx = cx;
+        if !self.identity {
+            let a = &self.a;
+            self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
+        }
+        for (k, &i) in self.a.iter().enumerate() {
             self.w[k] = border[i];
             self.t_a[k] = t[i];
         }
-        self.first.solve(&mut self.w);
+        self.solve_first(Part::W);
         let t_w: f64 = self.t_a.iter().zip(&self.w).map(|(a, b)| a * b).sum();
+        let b = &self.b;
         self.second.factor_written(nb + 1, |mut s| {
             gather(s.as_mut().submatrix_mut(0, 0, nb, nb), jacobian, b, cx);
             for (k, &i) in b.iter().enumerate() {
@@ -115,7 +127,7 @@ impl Split {
         for (k, &i) in self.a.iter().enumerate() {
             self.rhs_a[k] = rhs[i];
         }
-        self.first.solve(&mut self.rhs_a);
+        self.solve_first(Part::Rhs);
         for (k, &i) in self.b.iter().enumerate() {
             self.rhs_b[k] = rhs[i];
         }
@@ -134,13 +146,17 @@ impl Split {
 
     /// Factor and solve `c_x J Δu = rhs` (n), in place.
     fn solve_fixed(&mut self, jacobian: MatRef<'_, f64>, cx: f64, rhs: &mut [f64]) {
-        let (a, b) = (&self.a, &self.b);
-        self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
+        self.cx = cx;
+        if !self.identity {
+            let a = &self.a;
+            self.first.factor_written(a.len(), |m| gather(m, jacobian, a, cx));
+        }
+        let b = &self.b;
         self.second.factor_written(b.len(), |m| gather(m, jacobian, b, cx));
         for (k, &i) in self.a.iter().enumerate() {
             self.rhs_a[k] = rhs[i];
         }
-        self.first.solve(&mut self.rhs_a);
+        self.solve_first(Part::Rhs);
         let nb = self.b.len();
         for (k, &i) in self.b.iter().enumerate() {
             self.rhs_b[k] = rhs[i];
@@ -154,10 +170,34 @@ impl Split {
         }
     }
 
+    /// `(c_x J_a)⁻¹` applied to `w` or to the gathered right-hand side, in place.
+    fn solve_first(&mut self, part: Part) {
+        let values = match part {
+            Part::W => &mut self.w,
+            Part::Rhs => &mut self.rhs_a,
+        };
+        if self.identity {
+            values.iter_mut().for_each(|v| *v /= self.cx);
+        } else {
+            self.first.solve(values);
+        }
+    }
+
     fn bordered_determinant(&self) -> Determinant {
-        let (a, s) = (self.first.determinant(), self.second.determinant());
+        let a = match self.identity {
+            // det(c_x I) = c_x^|a|, c_x > 0.
+            true => Determinant { sign: 1.0, ln_abs: self.a.len() as f64 * self.cx.ln() },
+            false => self.first.determinant(),
+        };
+        let s = self.second.determinant();
         Determinant { sign: a.sign * s.sign, ln_abs: a.ln_abs + s.ln_abs }
     }
+}
+
+/// Which vector of a [`Split`] its first block's solve is applied to.
+enum Part {
+    W,
+    Rhs,
 }
 
 /// `block = c_x jacobian[rows, rows]`.
@@ -202,6 +242,9 @@ impl Workspace {
             Some(a) if !a.is_empty() && a.len() < self.n => {
                 if self.split.as_ref().is_none_or(|split| split.a != a) {
                     self.split = Some(Split::new(a, self.n));
+                }
+                if let Some(split) = self.split.as_mut() {
+                    split.identity = problem.decoupled_block_is_identity();
                 }
                 true
             }
@@ -408,17 +451,21 @@ mod tests {
     use super::*;
 
     /// `R(x, λ) = J x − λ c` with a Jacobian block diagonal in the unknowns {0, 2, 3} and
-    /// {1, 4}, declared as such or not.
+    /// {1, 4}, declared as such or not; with `identity`, the first block is the identity
+    /// (declared so with the blocks).
     struct Blocks {
         declare: bool,
+        identity: bool,
     }
 
     const A: [usize; 3] = [0, 2, 3];
 
-    fn jacobian(i: usize, j: usize) -> f64 {
+    fn jacobian(i: usize, j: usize, identity: bool) -> f64 {
         let same = A.contains(&i) == A.contains(&j);
         if !same {
             0.0
+        } else if identity && A.contains(&i) {
+            f64::from(i == j)
         } else if i == j {
             3.0 + i as f64
         } else {
@@ -440,12 +487,12 @@ mod tests {
         ) -> Result<(), ProblemError> {
             let c = [1.0, -2.0, 0.5, 0.25, 3.0];
             for i in 0..5 {
-                residual[i] = (0..5).map(|j| jacobian(i, j) * x[j]).sum::<f64>() - lambda * c[i];
+                residual[i] = (0..5).map(|j| jacobian(i, j, self.identity) * x[j]).sum::<f64>() - lambda * c[i];
             }
             if let Some((mut dx, dl)) = jacobian_out {
                 for i in 0..5 {
                     for j in 0..5 {
-                        dx[(i, j)] = jacobian(i, j);
+                        dx[(i, j)] = jacobian(i, j, self.identity);
                     }
                     dl[i] = -c[i];
                 }
@@ -456,22 +503,35 @@ mod tests {
         fn decoupled_unknowns(&self) -> Option<&[usize]> {
             self.declare.then_some(&A[..])
         }
+
+        fn decoupled_block_is_identity(&self) -> bool {
+            self.identity
+        }
     }
 
     /// The bordered system and a solve at fixed λ give the same solution (to 1e-14 of it) and
     /// the same bordered determinant (to 1e-13 in its logarithm, and its sign) whether the
     /// Jacobian's two blocks are factored apart or the whole matrix is; so does a second
-    /// right-hand side solved with the factors kept.
+    /// right-hand side solved with the factors kept. A first block declared the identity is
+    /// not factored, its solves divided by `c_x` (here 0.5) and its determinant `c_x³`: the
+    /// same again.
     #[test]
     fn split_blocks_solve_as_the_whole_matrix() {
+        for identity in [false, true] {
+            split_blocks_solve_as_the_whole_matrix_with(identity);
+        }
+    }
+
+    fn split_blocks_solve_as_the_whole_matrix_with(identity: bool) {
         let t = [0.3, -0.1, 0.7, 0.2, -0.5, 0.6];
         let rhs = [1.0, 2.0, -1.0, 0.5, 0.25, -0.75];
         let mut results = Vec::new();
         for declare in [false, true] {
-            let mut problem = Blocks { declare };
+            let mut problem = Blocks { declare, identity };
             let mut ws = Workspace::new(&mut problem);
             ws.evaluate(&mut problem, &[0.1, 0.2, 0.3, 0.4, 0.5], 1.5, true).unwrap();
             assert_eq!(ws.split_active, declare);
+            assert_eq!(ws.split.as_ref().is_some_and(|split| split.identity), declare && identity);
             ws.rhs.copy_from_slice(&rhs);
             assert!(ws.solve_bordered(&mut problem, 2.0, 0.5, 4.0, &t));
             let bordered = ws.rhs.clone();

@@ -190,6 +190,14 @@ pub trait Problem {
     fn decoupled_unknowns(&self) -> Option<&[usize]> {
         None
     }
+
+    /// Is the block of [`Self::decoupled_unknowns`] in the last dense `∂R/∂x` the identity
+    /// (unknowns the problem pins at zero by `R_a = x_a`: the even harmonics of a balance
+    /// whose solutions are half-wave symmetric)? The corrector then neither factors nor
+    /// gathers it. Default: no.
+    fn decoupled_block_is_identity(&self) -> bool {
+        false
+    }
 }
 
 /// `∂R/∂x` factored by the problem itself ([`Problem::factored`]).

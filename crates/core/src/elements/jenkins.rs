@@ -99,6 +99,12 @@ impl Element for Jenkins {
         Some(self.stiffness)
     }
 
+    /// The return mapping is odd in (u, w, f), the stuck-mean convention starts `−u` at `−w`,
+    /// and a motion that slips both ways forgets its start: its periodic regime is unique.
+    fn odd_symmetric(&self) -> bool {
+        true
+    }
+
     /// The return mapping of [`Element::update`] marched over a stretch, bit for bit the same
     /// steps: a slip moves the slider to `u − sgn(f_tr) F_c/k`, and `(±F_c)/k = ±(F_c/k)`
     /// exactly, so the division is made once instead of on the loop's dependency chain (the

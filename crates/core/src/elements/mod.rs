@@ -134,6 +134,14 @@ pub trait Element: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// Is the law odd: the force history of the motion `−u` is `−g`, and a symmetric motion
+    /// has one periodic regime? Then a half-wave symmetric motion, `u(t + T/2) = −u(t)`, has
+    /// half-wave symmetric forces, and a balance of such elements can pin its even harmonics
+    /// at zero. Default: no.
+    fn odd_symmetric(&self) -> bool {
+        false
+    }
+
     /// Entry `(a, b)` of the d×d stiffness `K_r` of the linear model that the element replaces
     /// (paper form, Eq. 11: `k_J`, a 1×1 matrix for a Jenkins element; `Vᵀ K V` of a stuck
     /// contact), so that the joint's own force is `f = g + K_r u`; 0 for elements that add to

@@ -23,7 +23,7 @@ use faer::{c64, Mat, MatMut};
 use multiversion::multiversion;
 
 use super::element_aft::{AftError, ElementAft};
-use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
+use super::fourier::{coefficient_is_even, cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
 use std::sync::Arc;
 
@@ -115,6 +115,13 @@ pub struct CondensedHbm<'m> {
     parity_split: bool,
     /// Offer the split where it holds (default; [`Self::without_parity_split`]).
     splits_parity: bool,
+    /// The balance's solutions are half-wave symmetric (every element an odd slider, an even
+    /// number of samples, excitation at the fundamental): the even harmonics are pinned at
+    /// zero, `R_even = x_even` (see [`Self::pins_even_harmonics`]). Cleared for good by the
+    /// first evaluation at an `x` with an even harmonic.
+    pins_even: bool,
+    /// The last residual was evaluated with the even harmonics pinned.
+    pinned: bool,
     /// Number of residual (and Jacobian) evaluations since creation.
     pub evaluations: usize,
 }
@@ -186,6 +193,8 @@ impl<'m> CondensedHbm<'m> {
                 .collect(),
             parity_split: false,
             splits_parity: true,
+            pins_even: false,
+            pinned: false,
             parity_masks: model
                 .elements
                 .iter()
@@ -200,6 +209,33 @@ impl<'m> CondensedHbm<'m> {
             plan,
             evaluations: 0,
         }
+        .with_even_harmonics_pinned_where_symmetric()
+    }
+
+    /// Pin the even harmonics where every solution is half-wave symmetric, `x(t + T/2) =
+    /// −x(t)`: every element an odd-symmetric slider (`g` of `−u` is `−g`, and its periodic
+    /// state is unique, so a symmetric motion has symmetric forces), an even number of
+    /// samples (so that `t + T/2` is a sample and the stick pattern is symmetric too), and a
+    /// Newton system large enough to be split ([`SPLIT_FROM`]). The excitation is at the
+    /// fundamental, odd. The even harmonics of such a balance are round-off (~1e-21 of a
+    /// 1e-5 m motion) and their equations decouple from the odd ones; pinned, a point costs
+    /// the odd harmonics' receptance, Jacobian and LU alone.
+    fn with_even_harmonics_pinned_where_symmetric(mut self) -> Self {
+        self.pins_even = self.sliders_only
+            && self.model.elements.iter().all(|e| e.law.odd_symmetric())
+            && self.plan.n_samples().is_multiple_of(2)
+            && self.q * self.plan.n_coeffs() >= SPLIT_FROM;
+        self
+    }
+
+    /// Are the even harmonics pinned at zero (`R_even = x_even`, the identity in `∂R/∂x`) and
+    /// the joints' forces evaluated over half a period ([`ElementAft::evaluate_half_wave`])?
+    /// Where the balance's solutions are half-wave symmetric, until an evaluation at an `x`
+    /// with an even harmonic (a guess from elsewhere; a continuation started from the linear
+    /// or stuck response keeps them exactly zero), after which the balance is the whole one.
+    /// Never with the structured factorisation.
+    pub fn pins_even_harmonics(&self) -> bool {
+        self.pins_even && !self.by_structure
     }
 
     /// Number of unknowns (2N+1)q.
@@ -294,13 +330,21 @@ impl<'m> CondensedHbm<'m> {
         self.evaluations += 1;
         self.last = None;
         let q = self.q;
-        self.element_forces(x, omega, want)?;
+        if self.pins_even && self.even_unknowns.iter().any(|&i| x[i] != 0.0) {
+            self.pins_even = false;
+        }
+        let pinned = self.pins_even_harmonics();
+        self.pinned = pinned;
+        self.joints.evaluate(self.model, &self.plan, x, omega, want, pinned)?;
         // The matrix H_k for a Jacobian, or where it costs no more than the products H_k G_k
         // that a residual alone needs (and a Jacobian completed from this residual then finds
         // it). The excitation's response u_F only on harmonic 1, the one it drives.
         let matrices = want || self.receptance.prefers_matrix();
         self.matrices_made = matrices;
         for k in 1..=self.plan.n_harmonics() {
+            if pinned && k % 2 == 0 {
+                continue;
+            }
             let hr = &mut self.harmonic[k - 1];
             match (k, matrices) {
                 (1, true) => self.receptance.evaluate_matrix(omega, hr),
@@ -308,17 +352,23 @@ impl<'m> CondensedHbm<'m> {
                 _ => self.receptance.evaluate_unforced(k as f64 * omega, hr, matrices),
             }
         }
-        // Harmonic 0: R_0 = x_0 + H(0) G_0.
+        // Harmonic 0: R_0 = x_0 + H(0) G_0 (pinned: R_0 = x_0).
         for i in 0..q {
             let mut r = x[i];
-            for j in 0..q {
+            for j in (0..q).filter(|_| !pinned) {
                 r += self.h0[(i, j)] * self.joints.g[j];
             }
             residual[i] = r;
         }
-        // Harmonic k: R_k = x_k − λ_F u_F δ_k1 + H_k G_k in the complex form c − i s.
+        // Harmonic k: R_k = x_k − λ_F u_F δ_k1 + H_k G_k in the complex form c − i s (pinned
+        // and even: R_k = x_k).
         for k in 1..=self.plan.n_harmonics() {
             let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+            if pinned && k % 2 == 0 {
+                residual[ic..ic + q].copy_from_slice(&x[ic..ic + q]);
+                residual[is..is + q].copy_from_slice(&x[is..is + q]);
+                continue;
+            }
             let g = &self.joints.g;
             for (j, a) in self.amplitudes.iter_mut().enumerate() {
                 *a = c64::new(g[ic + j], -g[is + j]);
@@ -365,11 +415,12 @@ impl<'m> CondensedHbm<'m> {
         dlevel: Option<&mut [f64]>,
     ) -> bool {
         let Some((omega, level)) = self.last.filter(|_| self.completes_jacobian()) else { return false };
-        if !self.joints.complete_jacobian(self.model, &self.plan) {
+        if !self.joints.complete_jacobian(self.model, &self.plan, self.pinned) {
             return false;
         }
         if !self.matrices_made {
-            for (k, hr) in self.harmonic.iter_mut().enumerate() {
+            let pinned = self.pinned;
+            for (k, hr) in self.harmonic.iter_mut().enumerate().filter(|(k, _)| !(pinned && (k + 1) % 2 == 0)) {
                 self.receptance.complete_matrix((k + 1) as f64 * omega, hr);
             }
             self.matrices_made = true;
@@ -443,7 +494,21 @@ impl<'m> CondensedHbm<'m> {
     /// round-off: the reference the split is tested against.
     pub fn without_parity_split(mut self) -> Self {
         self.splits_parity = false;
+        self.pins_even = false;
         self
+    }
+
+    /// The balance with its even harmonics solved like the odd ones even where its solutions
+    /// are half-wave symmetric: the reference [`Self::pins_even_harmonics`] is tested against.
+    pub fn without_pinned_even_harmonics(mut self) -> Self {
+        self.pins_even = false;
+        self
+    }
+
+    /// Is the even block of the last `∂R/∂x` assembled the identity (the even harmonics
+    /// pinned)? For the corrector, which then neither gathers nor factors it.
+    pub fn decoupled_block_is_identity(&self) -> bool {
+        self.parity_split && self.pinned
     }
 
     fn assemble_jacobian(&mut self, mut dx: MatMut<'_, f64>, nc: usize) {
@@ -454,17 +519,19 @@ impl<'m> CondensedHbm<'m> {
         // `PARITY_COUPLING` of its largest term, it is left out (a change of the Newton
         // matrix by less than that, which moves no converged point beyond round-off) and the
         // matrix is block diagonal in the even and odd harmonics.
-        self.parity_split = self.splits_parity
-            && q * nc >= SPLIT_FROM
-            && self.model.elements.iter().enumerate().all(|(e, site)| {
-                let stiffness = site.law.slider_stiffness().unwrap_or(0.0);
-                parity_coupling_negligible(
-                    &self.joints.elem_jac[e],
-                    site.law.n_dirs(),
-                    &self.parity_masks[e],
-                    stiffness,
-                )
-            });
+        let pinned = self.pinned;
+        self.parity_split = pinned
+            || self.splits_parity
+                && q * nc >= SPLIT_FROM
+                && self.model.elements.iter().enumerate().all(|(e, site)| {
+                    let stiffness = site.law.slider_stiffness().unwrap_or(0.0);
+                    parity_coupling_negligible(
+                        &self.joints.elem_jac[e],
+                        site.law.n_dirs(),
+                        &self.parity_masks[e],
+                        stiffness,
+                    )
+                });
         let split = self.parity_split;
         // Each column of the H_k, harmonic after harmonic, with its real and imaginary parts
         // apart: laid out as a column of ∂R/∂x below its first q rows (cos then sin rows of
@@ -496,7 +563,12 @@ impl<'m> CondensedHbm<'m> {
                 for b in 0..d {
                     let col = c2 * q + off + b;
                     let column = dx.as_mut().col_mut(col).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                    assemble_column(column, &element, je.col_as_slice(c2 * d + b), even);
+                    if pinned && even == Some(true) {
+                        // R_even = x_even: a column of the identity.
+                        column.fill(0.0);
+                    } else {
+                        assemble_column(column, &element, je.col_as_slice(c2 * d + b), even);
+                    }
                     column[col] += 1.0;
                 }
             }
@@ -508,14 +580,20 @@ impl<'m> CondensedHbm<'m> {
         let q = self.q;
         // ∂R/∂Ω = −λ_F ∂u_F/∂Ω + ∂H/∂Ω G + H ∂G/∂Ω, with ∂H_k/∂Ω = k H'(kΩ).
         if let Some(dw) = domega {
+            let pinned = self.pinned;
             for i in 0..q {
-                dw[i] = (0..q).map(|j| self.h0[(i, j)] * self.joints.dg_domega[j]).sum();
+                dw[i] = if pinned { 0.0 } else { (0..q).map(|j| self.h0[(i, j)] * self.joints.dg_domega[j]).sum() };
             }
             // Laws that do not depend on the velocity (sliders) have ∂G/∂Ω = 0: no product.
             let dg_zero = self.joints.dg_domega.iter().all(|v| *v == 0.0);
             for k in 1..=self.plan.n_harmonics() {
                 let hr = &mut self.harmonic[k - 1];
                 let (ic, is) = (cos_index(k) * q, sin_index(k) * q);
+                if pinned && k % 2 == 0 {
+                    dw[ic..ic + q].fill(0.0);
+                    dw[is..is + q].fill(0.0);
+                    continue;
+                }
                 let (g, dg) = (&self.joints.g, &self.joints.dg_domega);
                 // k dH/dω(kΩ) G_k ...
                 for (j, a) in self.amplitudes.iter_mut().enumerate() {
@@ -600,7 +678,7 @@ impl<'m> CondensedHbm<'m> {
     /// AFT of every element (Eq. 15): `G(x)` and, if `want`, `∂G/∂Ω` and each element's block
     /// of `∂G/∂x` ([`JointForces`]).
     fn element_forces(&mut self, x: &[f64], omega: f64, want: bool) -> Result<(), HbmError> {
-        Ok(self.joints.evaluate(self.model, &self.plan, x, omega, want)?)
+        Ok(self.joints.evaluate(self.model, &self.plan, x, omega, want, false)?)
     }
 
     /// `∂G/∂x` at `x` and Ω (q(2N+1) square, coefficient-major as the unknowns): the joints'
@@ -639,7 +717,7 @@ impl<'m> CondensedHbm<'m> {
     /// evaluated at `x`.
     pub fn element_force_jacobian_at_last(&mut self, x: &[f64], omega: f64) -> Result<Mat<f64>, HbmError> {
         let here = self.last.is_some_and(|(w, _)| w == omega) && self.last_x == x;
-        if !(here && self.sliders_only && self.joints.complete_jacobian(self.model, &self.plan)) {
+        if !(here && self.sliders_only && self.joints.complete_jacobian(self.model, &self.plan, false)) {
             return self.element_force_jacobian(x, omega);
         }
         let jac = self.joints.assembled_jacobian(self.model, self.plan.n_coeffs(), |_, _| {});
@@ -770,11 +848,6 @@ const PARITY_COUPLING: f64 = 1e-12;
 /// they save: counted on whole runs (instructions), Table 6 (15 unknowns) took 2 % more split
 /// and the 10-DOF chain with 4 sliders (60 unknowns) 8 % less.
 const SPLIT_FROM: usize = 32;
-
-/// Is the harmonic of Fourier coefficient `c` (0; cos 1, sin 1; cos 2, ...) even?
-fn coefficient_is_even(c: usize) -> bool {
-    c.div_ceil(2).is_multiple_of(2)
-}
 
 /// Does an element's Jacobian (`(nc d) × (nc d)`, coefficient-major) couple harmonics of
 /// opposite parity by no more than [`PARITY_COUPLING`] of its largest term or of its

@@ -42,7 +42,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{c64, Accum, Mat, MatMut, Par};
 
-use super::fourier::{AftPlan, AftScratch};
+use super::fourier::{coefficient_is_even, AftPlan, AftScratch};
 use crate::elements::{Element, Tangent};
 
 /// Periods marched at most before declaring that the law has no periodic regime.
@@ -175,14 +175,59 @@ impl ElementAft {
         g_coeffs: &mut [f64],
         jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
     ) -> Result<(), AftError> {
+        self.evaluate_with_symmetry(law, plan, omega, u_coeffs, g_coeffs, jacobian, false)
+    }
+
+    /// [`Self::evaluate`] of a half-wave symmetric motion, `u(t + T/2) = −u(t)` (its even
+    /// harmonics are not read): for a slider (an odd law) with an even number of samples, the
+    /// samples of the odd harmonics by [`AftPlan::synthesize_half_wave`], exactly symmetric,
+    /// half a period marched from the periodic start and the other half its negative (the
+    /// return mapping is odd, so marching it gives the same values, bit for bit), and the
+    /// force harmonics from the first half ([`AftPlan::analyze_half_wave`]: the even ones
+    /// zero). Other laws as [`Self::evaluate`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn evaluate_half_wave(
+        &mut self,
+        law: &dyn Element,
+        plan: &AftPlan,
+        omega: f64,
+        u_coeffs: &[f64],
+        g_coeffs: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+    ) -> Result<(), AftError> {
+        self.evaluate_with_symmetry(law, plan, omega, u_coeffs, g_coeffs, jacobian, true)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate_with_symmetry(
+        &mut self,
+        law: &dyn Element,
+        plan: &AftPlan,
+        omega: f64,
+        u_coeffs: &[f64],
+        g_coeffs: &mut [f64],
+        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
+        half_wave: bool,
+    ) -> Result<(), AftError> {
         let (d, s, nc, nt) = (self.d, self.s, self.nc, self.nt);
         debug_assert_eq!(u_coeffs.len(), nc * d);
         // Samples of u and, for a law that reads them, du/dθ (Eq. 15, DFT⁻¹). A rate-independent
         // law never sees its velocity: one inverse transform per direction instead of two.
         let velocity = law.depends_on_velocity();
+        let half_wave = half_wave
+            && plan.has_half_wave()
+            && law.odd_symmetric()
+            && law.slider_stiffness().is_some()
+            && d == 1
+            && s == 1
+            && !velocity;
         for a in 0..d {
             for c in 0..nc {
                 self.coeff_buf[c] = u_coeffs[c * d + a];
+            }
+            if half_wave {
+                plan.synthesize_half_wave(&self.coeff_buf, &mut self.u[a * nt..(a + 1) * nt]);
+                continue;
             }
             plan.synthesize(&self.coeff_buf, &mut self.u[a * nt..(a + 1) * nt], &mut self.scratch);
             if velocity {
@@ -240,7 +285,24 @@ impl ElementAft {
             if chain_rule {
                 self.sens_period_start.copy_from_slice(&self.sens);
             }
-            if slider.is_some() {
+            if slider.is_some() && half_wave && known.is_some() {
+                // Half a period and one sample marched (the first sample alone, for the state
+                // after it), the rest the negative of the marched half: the state after the
+                // period's last sample is the negative of the state after the half's last.
+                let half = nt / 2;
+                let mut w = self.state[0];
+                self.march_slider(law, j0, 0..1, &mut w);
+                self.state_after_start[0] = w;
+                self.march_slider(law, j0, 1..half, &mut w);
+                let w_half = w;
+                self.march_slider(law, j0, half..half + 1, &mut w);
+                for m in half + 1..nt {
+                    let (j, source) = (wrap(j0 + m, nt), wrap(j0 + m - half, nt));
+                    self.g[j] = -self.g[source];
+                    self.slipping[j] = self.slipping[source];
+                }
+                self.state[0] = -w_half;
+            } else if slider.is_some() {
                 // The same steps in three stretches (the first sample alone, for the state
                 // after it), then the anchors from the slip flags.
                 let mut w = self.state[0];
@@ -251,6 +313,8 @@ impl ElementAft {
                     }
                 }
                 self.state[0] = w;
+            }
+            if slider.is_some() {
                 // In marching order, the two stretches without a wrap per sample.
                 let mut last_slip = anchor.unwrap_or(usize::MAX);
                 for range in [j0..nt, 0..j0] {
@@ -324,8 +388,12 @@ impl ElementAft {
 
         // Project back (Eq. 15, DFT).
         for a in 0..d {
-            self.time_buf.copy_from_slice(&self.g[a * nt..(a + 1) * nt]);
-            plan.analyze(&self.time_buf, &mut self.coeff_buf, &mut self.scratch);
+            if half_wave {
+                plan.analyze_half_wave(&self.g[a * nt..(a + 1) * nt], &mut self.coeff_buf);
+            } else {
+                self.time_buf.copy_from_slice(&self.g[a * nt..(a + 1) * nt]);
+                plan.analyze(&self.time_buf, &mut self.coeff_buf, &mut self.scratch);
+            }
             for c in 0..nc {
                 g_coeffs[c * d + a] = self.coeff_buf[c];
             }
@@ -335,7 +403,7 @@ impl ElementAft {
         if let Some((mut jac, dg_domega)) = jacobian {
             if let Some(k) = slider {
                 self.slider_jacobian_of = Some((k, j0));
-                self.slider_jacobian(plan, k, law.replaced_stiffness(0, 0), j0, jac);
+                self.slider_jacobian(plan, k, law.replaced_stiffness(0, 0), j0, jac, false);
                 dg_domega.iter_mut().for_each(|v| *v = 0.0);
                 return Ok(());
             }
@@ -357,18 +425,34 @@ impl ElementAft {
     /// The Jacobian of the last evaluation, made without one, of a slider: `J = ∂G/∂X` and
     /// `∂G/∂Ω` (zero) as [`Self::evaluate`] would have written them. False, nothing written,
     /// if the law was not a slider (its Jacobian needs the march).
-    pub fn complete_slider_jacobian(&mut self, plan: &AftPlan, jac: MatMut<'_, f64>, dg_domega: &mut [f64]) -> bool {
+    /// With `odd_only`, only the entries between odd harmonics are written (the others keep
+    /// what they held): what a balance with its even harmonics pinned reads.
+    pub fn complete_slider_jacobian(
+        &mut self,
+        plan: &AftPlan,
+        jac: MatMut<'_, f64>,
+        dg_domega: &mut [f64],
+        odd_only: bool,
+    ) -> bool {
         let Some((k, k_r, j0)) = self.last_slider else { return false };
         self.slider_jacobian_of = Some((k, j0));
-        self.slider_jacobian(plan, k, k_r, j0, jac);
+        self.slider_jacobian(plan, k, k_r, j0, jac, odd_only);
         dg_domega.iter_mut().for_each(|v| *v = 0.0);
         true
     }
 
     /// Closed-form Jacobian of a slider (module docs) from the stick flags and anchors of the
     /// periodic regime; `k_r` is the stiffness the element replaces, `j0` the march's first
-    /// sample.
-    fn slider_jacobian(&mut self, plan: &AftPlan, k: f64, k_r: f64, j0: usize, mut jac: MatMut<'_, f64>) {
+    /// sample. With `odd_only`, the entries between odd harmonics alone.
+    fn slider_jacobian(
+        &mut self,
+        plan: &AftPlan,
+        k: f64,
+        k_r: f64,
+        j0: usize,
+        mut jac: MatMut<'_, f64>,
+        odd_only: bool,
+    ) {
         let (nc, nt) = (self.nc, self.nt);
         // The stick phases in marching order (first sample, samples, anchor): the samples
         // stuck to one anchor, or at rest with none (`NO_ANCHOR`: stuck since the march began,
@@ -414,14 +498,15 @@ impl ElementAft {
         let ws = |m: isize| m.signum() as f64 * self.weight_sin[m.unsigned_abs()];
         let n = nc / 2;
         let scale = |c: usize| if c == 0 { 1.0 } else { 2.0 } / nt as f64;
-        for b in 0..=n {
+        let harmonics = move || (0..=n).filter(move |h| !odd_only || h % 2 == 1);
+        for b in harmonics() {
             // The columns of harmonic b: cos (c' = 2b − 1, or 0) and sin (c' = 2b, the next),
             // as contiguous slices (this runs at every Jacobian of every slider).
             let cos_col = if b == 0 { 0 } else { 2 * b - 1 };
             let (left, right) = jac.as_mut().split_at_col_mut(cos_col + 1);
             let cos_column = column_slice(left, cos_col);
             let mut sin_column = (b > 0).then(|| column_slice(right, 0));
-            for a in 0..=n {
+            for a in harmonics() {
                 let (d, s) = ((a as isize) - (b as isize), (a + b) as isize);
                 let (cos_row, sin_row) = if a == 0 { (0, None) } else { (2 * a - 1, Some(2 * a)) };
                 let (wc_d, wc_s, ws_d, ws_s) = (wc(d), wc(s), ws(d), ws(s));
@@ -443,9 +528,14 @@ impl ElementAft {
             self.coeff_buf.iter_mut().for_each(|v| *v *= k);
             let e_a = plan.basis_at(anchor);
             for (c2, &e) in e_a.iter().enumerate() {
+                if odd_only && coefficient_is_even(c2) {
+                    continue;
+                }
                 let column = jac.as_mut().col_mut(c2).try_as_col_major_mut().expect("column-major").as_slice_mut();
-                for (entry, pc) in column.iter_mut().zip(&self.coeff_buf) {
-                    *entry -= pc * e;
+                for (c, (entry, pc)) in column.iter_mut().zip(&self.coeff_buf).enumerate() {
+                    if !(odd_only && coefficient_is_even(c)) {
+                        *entry -= pc * e;
+                    }
                 }
             }
         }
@@ -518,6 +608,19 @@ impl ElementAft {
     /// After a marched period that did not repeat: Aitken's jump to the periodic state (see the
     /// march) when this period's state change and the previous one's (`previous_marched`) are
     /// parallel and shrinking; keeps this period's change for the next call. True if it jumped.
+    /// March a slider (one direction, one state `w`) over the samples `j0 + m` for `m` in
+    /// `steps` (marching order, wrapping past the period's end): its forces and slip flags.
+    fn march_slider(&mut self, law: &dyn Element, j0: usize, steps: std::ops::Range<usize>, w: &mut f64) {
+        let nt = self.nt;
+        let first = wrap(j0 + steps.start, nt);
+        let end = first + steps.len();
+        for range in [first..end.min(nt), 0..end.saturating_sub(nt)] {
+            if !range.is_empty() {
+                law.update_slider_samples(&self.u, &self.v, range, w, &mut self.g, &mut self.slipping);
+            }
+        }
+    }
+
     fn extrapolate_period(&mut self, previous_marched: bool, chain_rule: bool) -> bool {
         let (mut now, mut before, mut dot) = (0.0, 0.0, 0.0);
         for m in 0..self.s {
@@ -672,6 +775,55 @@ mod tests {
         // Energy per cycle from the harmonics (exact for the truncated motion): π Σ k (s_k g_ck − c_k g_sk).
         let w = std::f64::consts::PI * (0.0 - a * g[sin_index(1)]);
         (g[cos_index(1)], g[sin_index(1)], w, aft)
+    }
+
+    /// Half a period marched and mirrored equals the whole period marched: on motions of odd
+    /// harmonics where a Jenkins slider (paper form and standalone) slips both ways, with the
+    /// period's largest displacement, where the march starts, moved round the period (so that
+    /// the half wraps past its end), the same slip flags at every sample, force harmonics within
+    /// 1e-13 of the largest (the transforms round differently: direct sums against FFTs) and
+    /// even ones zero, and the closed-form Jacobian's odd entries within 1e-12 of its largest
+    /// (the same stick phases; the odd-only completion writes no other entry). A mirror off by
+    /// one sample moves the forces by ~1e-2.
+    #[test]
+    fn half_a_period_mirrored_equals_the_whole_period_marched() {
+        let plan = AftPlan::new(7, 300).unwrap();
+        let nc = plan.n_coeffs();
+        for law in [Jenkins::replacing_stiffness(8.11e6, 1000.0).unwrap(), Jenkins::new(2e5, 10.0).unwrap()] {
+            for phase in [0.0, 1.3, 2.9, 4.4, 6.0] {
+                let a = 3.0 * law.threshold() / law.stiffness();
+                let mut u = vec![0.0; nc];
+                for (k, amplitude) in [(1, a), (3, 0.2 * a), (5, 0.05 * a)] {
+                    u[cos_index(k)] = amplitude * (k as f64 * phase).cos();
+                    u[sin_index(k)] = amplitude * (k as f64 * phase).sin();
+                }
+                let (mut whole, mut half) = (ElementAft::new(&law, &plan), ElementAft::new(&law, &plan));
+                let (mut g_whole, mut g_half) = (vec![0.0; nc], vec![0.0; nc]);
+                whole.evaluate(&law, &plan, 1500.0, &u, &mut g_whole, None).unwrap();
+                half.evaluate_half_wave(&law, &plan, 1500.0, &u, &mut g_half, None).unwrap();
+                assert_eq!(whole.slipping, half.slipping, "phase {phase}");
+                assert!(half.slipping.iter().any(|&s| s) && !half.slipping.iter().all(|&s| s));
+                let largest = g_whole.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for c in 0..nc {
+                    let expected = if coefficient_is_even(c) { 0.0 } else { g_whole[c] };
+                    assert!((g_half[c] - expected).abs() <= 1e-13 * largest, "phase {phase}, c {c}");
+                }
+                let (mut j_whole, mut j_half) = (Mat::<f64>::zeros(nc, nc), Mat::<f64>::zeros(nc, nc));
+                let mut dgdw = vec![0.0; nc];
+                assert!(whole.complete_slider_jacobian(&plan, j_whole.as_mut(), &mut dgdw, false));
+                assert!(half.complete_slider_jacobian(&plan, j_half.as_mut(), &mut dgdw, true));
+                let largest = (0..nc)
+                    .flat_map(|i| (0..nc).map(move |j| (i, j)))
+                    .fold(0.0f64, |m, (i, j)| m.max(j_whole[(i, j)].abs()));
+                for i in 0..nc {
+                    for j in 0..nc {
+                        let odd = !coefficient_is_even(i) && !coefficient_is_even(j);
+                        let expected = if odd { j_whole[(i, j)] } else { 0.0 };
+                        assert!((j_half[(i, j)] - expected).abs() <= 1e-12 * largest, "phase {phase}, ({i}, {j})");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -19,6 +19,7 @@
 //! Time samples are `θ_j = 2π j / n_t`, `j = 0..n_t`. Complex amplitude of harmonic k is
 //! `X_k = c_k − i s_k`, so that `x = c0 + Re Σ X_k e^{ikθ}`.
 
+use multiversion::multiversion;
 use std::sync::Arc;
 
 use faer::Mat;
@@ -35,6 +36,11 @@ pub fn cos_index(k: usize) -> usize {
 #[inline]
 pub fn sin_index(k: usize) -> usize {
     2 * k
+}
+
+/// Is the harmonic of Fourier coefficient `c` (0; cos 1, sin 1; cos 2, ...) even?
+pub fn coefficient_is_even(c: usize) -> bool {
+    c.div_ceil(2).is_multiple_of(2)
 }
 
 /// Errors building a Fourier plan.
@@ -74,6 +80,13 @@ pub struct AftPlan {
     /// ([`Self::add_fourier_sums`]).
     cos_prefix: Mat<f64>,
     sin_prefix: Mat<f64>,
+    /// For an even `n_t`, the coefficients of the odd harmonics (cos k, sin k for k = 1, 3, ...)
+    /// and, one contiguous row of `n_t/2` samples each: their basis on the first half period
+    /// and their projection weights from it (`4/n_t` times the basis: a half-wave symmetric
+    /// signal, `x(θ + π) = −x(θ)`, has both halves' terms alike). Empty for an odd `n_t`.
+    odd_coeffs: Vec<usize>,
+    half_synthesis: Vec<f64>,
+    half_projection: Vec<f64>,
 }
 
 impl std::fmt::Debug for AftPlan {
@@ -118,6 +131,14 @@ impl AftPlan {
         let sin_prefix = running_sums(2 * n_harmonics + 1, n_samples, |m, j| angle(m, j).sin());
         let basis_at_sample = synthesis.transpose().to_owned();
         let basis_derivative_at_sample = synthesis_derivative.transpose().to_owned();
+        let half = n_samples / 2;
+        let odd_coeffs: Vec<usize> = match n_samples % 2 {
+            0 => (1..nc).filter(|&c| !coefficient_is_even(c)).collect(),
+            _ => Vec::new(),
+        };
+        let half_synthesis: Vec<f64> =
+            odd_coeffs.iter().flat_map(|&c| (0..half).map(move |j| basis(c, j as f64 * dtheta))).collect();
+        let half_projection = half_synthesis.iter().map(|b| 4.0 / n_samples as f64 * b).collect();
         Ok(AftPlan {
             n_harmonics,
             n_samples,
@@ -129,6 +150,9 @@ impl AftPlan {
             basis_derivative_at_sample,
             projection,
             projection_prefix,
+            odd_coeffs,
+            half_synthesis,
+            half_projection,
             cos_prefix,
             sin_prefix,
         })
@@ -213,6 +237,38 @@ impl AftPlan {
         &self.projection
     }
 
+    /// Do [`Self::synthesize_half_wave`] and [`Self::analyze_half_wave`] apply (an even number
+    /// of samples, so that θ + π is a sample)?
+    pub fn has_half_wave(&self) -> bool {
+        !self.odd_coeffs.is_empty()
+    }
+
+    /// Samples of the half-wave symmetric signal of the odd harmonics of `coeffs` (the even
+    /// ones are not read): the first half period by direct sums of the N/2 odd harmonics, the
+    /// second its negative, `x_{j+n_t/2} = −x_j` exactly. For N ≪ n_t a quarter of the
+    /// operations of the whole sums and fewer than an inverse FFT, which has no form for half
+    /// a spectrum (written here for that reason). Needs [`Self::has_half_wave`].
+    pub fn synthesize_half_wave(&self, coeffs: &[f64], samples: &mut [f64]) {
+        assert!(self.has_half_wave(), "half-wave synthesis needs an even number of samples");
+        assert_eq!(samples.len(), self.n_samples, "expected {} samples, got {}", self.n_samples, samples.len());
+        let (first, second) = samples.split_at_mut(self.n_samples / 2);
+        half_synthesize(&self.half_synthesis, &self.odd_coeffs, coeffs, first);
+        for (b, a) in second.iter_mut().zip(first.iter()) {
+            *b = -*a;
+        }
+    }
+
+    /// The coefficients of a half-wave symmetric signal from its first half period (the
+    /// second is not read): the odd harmonics by the DFT's sums, twice those of the first
+    /// half; the even ones, which such a signal does not have, zero. The counterpart of
+    /// [`Self::synthesize_half_wave`].
+    pub fn analyze_half_wave(&self, samples: &[f64], coeffs: &mut [f64]) {
+        assert!(self.has_half_wave(), "half-wave analysis needs an even number of samples");
+        assert_eq!(coeffs.len(), self.n_coeffs(), "expected {} coefficients, got {}", self.n_coeffs(), coeffs.len());
+        coeffs.fill(0.0);
+        half_analyze(&self.half_projection, &self.odd_coeffs, &samples[..self.n_samples / 2], coeffs);
+    }
+
     /// Temporaries for [`synthesize`](Self::synthesize) and [`analyze`](Self::analyze).
     pub fn scratch(&self) -> AftScratch {
         let len = self.forward.get_scratch_len().max(self.inverse.get_scratch_len());
@@ -270,6 +326,37 @@ impl AftPlan {
             coeffs[cos_index(k)] = 2.0 * z.re * scale;
             coeffs[sin_index(k)] = -2.0 * z.im * scale;
         }
+    }
+}
+
+/// `out = Σ_o coeffs[odd[o]] table[o]` (rows of `out.len()`), row after row so that the loop
+/// over the samples vectorises.
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn half_synthesize(table: &[f64], odd: &[usize], coeffs: &[f64], out: &mut [f64]) {
+    let half = out.len();
+    out.fill(0.0);
+    for (row, &c) in table.chunks_exact(half).zip(odd) {
+        let x = coeffs[c];
+        for (o, b) in out.iter_mut().zip(row) {
+            *o += x * b;
+        }
+    }
+}
+
+/// `coeffs[odd[o]] = table[o] · samples`, each on four partial sums so that it vectorises.
+#[multiversion(targets("x86_64+avx2+fma", "x86_64+avx"))]
+fn half_analyze(table: &[f64], odd: &[usize], samples: &[f64], coeffs: &mut [f64]) {
+    let half = samples.len();
+    for (row, &c) in table.chunks_exact(half).zip(odd) {
+        let mut sums = [0.0; 4];
+        let (rows, values) = (row.chunks_exact(4), samples.chunks_exact(4));
+        let tail: f64 = rows.remainder().iter().zip(values.remainder()).map(|(a, b)| a * b).sum();
+        for (r, v) in rows.zip(values) {
+            for l in 0..4 {
+                sums[l] += r[l] * v[l];
+            }
+        }
+        coeffs[c] = (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail;
     }
 }
 
@@ -338,6 +425,34 @@ mod tests {
         let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt();
         let den: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
         num / den
+    }
+
+    /// The half-wave transforms equal the FFTs on a signal of odd harmonics (N = 7, 300 and 64
+    /// samples): samples and coefficients within 5e-15 in norm (measured 1.1e-15: the FFT's
+    /// error grows as ε log₂ n_t, ~8 ε at 300), the second half exactly the first's negative,
+    /// the even coefficients exactly zero; and an odd number of samples has none.
+    #[test]
+    fn half_wave_transforms_equal_the_ffts_on_odd_harmonics() {
+        for nt in [300, 64] {
+            let plan = AftPlan::new(7, nt).unwrap();
+            assert!(plan.has_half_wave());
+            let mut scratch = plan.scratch();
+            let coeffs: Vec<f64> = (0..15)
+                .map(|c| if coefficient_is_even(c) { 0.0 } else { ((c * 7 + 3) % 11) as f64 * 0.1 - 0.45 })
+                .collect();
+            let (mut fft, mut half) = (vec![0.0; nt], vec![0.0; nt]);
+            plan.synthesize(&coeffs, &mut fft, &mut scratch);
+            plan.synthesize_half_wave(&coeffs, &mut half);
+            assert!(rel_err(&half, &fft) <= 5e-15, "{:e}", rel_err(&half, &fft));
+            assert!((0..nt / 2).all(|j| half[j + nt / 2] == -half[j]));
+            let (mut back_fft, mut back_half) = (vec![0.0; 15], vec![0.0; 15]);
+            plan.analyze(&half, &mut back_fft, &mut scratch);
+            plan.analyze_half_wave(&half, &mut back_half);
+            assert!(rel_err(&back_half, &coeffs) <= 5e-15, "{back_half:?}");
+            assert!(rel_err(&back_fft, &back_half) <= 5e-15);
+            assert!((0..15).filter(|&c| coefficient_is_even(c)).all(|c| back_half[c] == 0.0));
+        }
+        assert!(!AftPlan::new(7, 301).unwrap().has_half_wave());
     }
 
     #[test]

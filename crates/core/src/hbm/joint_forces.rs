@@ -52,7 +52,8 @@ impl JointForces {
 
     /// AFT of every element for the motion `x` (harmonics on the directions, coefficient-major)
     /// at Ω: `G` and, if `want`, `∂G/∂Ω` and each element's block of `∂G/∂x` (else `∂G/∂Ω`
-    /// is zeroed).
+    /// is zeroed). With `half_wave`, `x` is half-wave symmetric (its even harmonics are not
+    /// read) and each element's AFT may use it ([`ElementAft::evaluate_half_wave`]).
     pub fn evaluate(
         &mut self,
         model: &NonlinearModel,
@@ -60,6 +61,7 @@ impl JointForces {
         x: &[f64],
         omega: f64,
         want: bool,
+        half_wave: bool,
     ) -> Result<(), AftError> {
         let (q, nc) = (self.q, plan.n_coeffs());
         for (e, site) in model.elements.iter().enumerate() {
@@ -71,7 +73,11 @@ impl JointForces {
                 }
             }
             let jac = if want { Some((self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e][..])) } else { None };
-            self.afts[e].evaluate(site.law.as_ref(), plan, omega, &self.elem_u[e], &mut self.elem_g[e], jac)?;
+            let (aft, law, u, g) = (&mut self.afts[e], site.law.as_ref(), &self.elem_u[e], &mut self.elem_g[e]);
+            match half_wave {
+                true => aft.evaluate_half_wave(law, plan, omega, u, g, jac)?,
+                false => aft.evaluate(law, plan, omega, u, g, jac)?,
+            }
             for c in 0..nc {
                 for a in 0..d {
                     let row = c * q + off + a;
@@ -85,11 +91,12 @@ impl JointForces {
 
     /// Each element's block of `∂G/∂x` and `∂G/∂Ω` at the last evaluation, made without them,
     /// when every element is a slider ([`ElementAft::complete_slider_jacobian`]); false if one
-    /// is not.
-    pub fn complete_jacobian(&mut self, model: &NonlinearModel, plan: &AftPlan) -> bool {
+    /// is not. With `odd_only`, the blocks' entries between odd harmonics alone.
+    pub fn complete_jacobian(&mut self, model: &NonlinearModel, plan: &AftPlan, odd_only: bool) -> bool {
         let (q, nc) = (self.q, plan.n_coeffs());
         for (e, site) in model.elements.iter().enumerate() {
-            if !self.afts[e].complete_slider_jacobian(plan, self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e]) {
+            let (jac, dgdw) = (self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e]);
+            if !self.afts[e].complete_slider_jacobian(plan, jac, dgdw, odd_only) {
                 return false;
             }
             let (d, off) = (site.law.n_dirs(), self.offsets[e]);

@@ -380,7 +380,7 @@ impl<'m> NonlinearMode<'m> {
         for (u, v) in self.u.iter_mut().zip(y) {
             *u = amplitude * v;
         }
-        self.joints.evaluate(self.model, &self.plan, &self.u, omega, want)
+        self.joints.evaluate(self.model, &self.plan, &self.u, omega, want, false)
     }
 
     /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives in Ω and ξ: the linear part with the

@@ -66,6 +66,10 @@ impl Problem for FrequencySweep<'_, '_> {
         self.hbm.decoupled_unknowns()
     }
 
+    fn decoupled_block_is_identity(&self) -> bool {
+        self.hbm.decoupled_block_is_identity()
+    }
+
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
         if self.hbm.factors_by_structure() {
             Some(self)
@@ -117,6 +121,10 @@ impl Problem for LevelSweep<'_, '_> {
 
     fn decoupled_unknowns(&self) -> Option<&[usize]> {
         self.hbm.decoupled_unknowns()
+    }
+
+    fn decoupled_block_is_identity(&self) -> bool {
+        self.hbm.decoupled_block_is_identity()
     }
 
     fn factored(&mut self) -> Option<&mut dyn FactoredJacobian> {
