@@ -214,18 +214,46 @@ impl<'m> CondensedHbm<'m> {
 
     /// Pin the even harmonics where every solution is half-wave symmetric, `x(t + T/2) =
     /// −x(t)`: every element an odd-symmetric slider (`g` of `−u` is `−g`, and its periodic
-    /// state is unique, so a symmetric motion has symmetric forces), an even number of
-    /// samples (so that `t + T/2` is a sample and the stick pattern is symmetric too), and a
-    /// Newton system large enough to be split ([`SPLIT_FROM`]). The excitation is at the
-    /// fundamental, odd. The even harmonics of such a balance are round-off (~1e-21 of a
-    /// 1e-5 m motion) and their equations decouple from the odd ones; pinned, a point costs
-    /// the odd harmonics' receptance, Jacobian and LU alone.
+    /// state is unique, so a symmetric motion has symmetric forces) and an even number of
+    /// samples (so that `t + T/2` is a sample and the stick pattern is symmetric too). The
+    /// excitation is at the fundamental, odd. The even harmonics of such a balance are
+    /// round-off (~1e-21 of a 1e-5 m motion) and their equations decouple from the odd ones;
+    /// pinned, a point costs the odd harmonics' receptance, Jacobian and LU alone, and the
+    /// sliders' AFT over half a period. Unlike the split of a Jacobian that is only found
+    /// block diagonal ([`SPLIT_FROM`]), this pays at any size: nothing of the even block is
+    /// gathered or factored.
+    ///
+    /// Not where the model leaves the joints' mean positions free once they slip (a part held
+    /// by joints alone, each replacing the only stiffness there is): there the balance's
+    /// solutions are not isolated (any mean will do), which the whole balance's singular
+    /// harmonic-0 equations make the continuation stop on and diagnose, where pinning would
+    /// quietly choose the mean zero.
     fn with_even_harmonics_pinned_where_symmetric(mut self) -> Self {
         self.pins_even = self.sliders_only
             && self.model.elements.iter().all(|e| e.law.odd_symmetric())
             && self.plan.n_samples().is_multiple_of(2)
-            && self.q * self.plan.n_coeffs() >= SPLIT_FROM;
+            && self.means_held_when_slipping();
         self
+    }
+
+    /// Does the model hold the directions' mean positions with every joint slipping: is the
+    /// static stiffness condensed on them, `H(0)⁻¹`, less the stiffness the joints replace,
+    /// positive definite (its smallest eigenvalue above 1e-9 of its largest, far above the
+    /// round-off of the difference, ~1e-16 of the stiffness)?
+    fn means_held_when_slipping(&self) -> bool {
+        use faer::linalg::solvers::DenseSolveCore;
+        let mut s = self.h0.partial_piv_lu().inverse();
+        for (e, site) in self.model.elements.iter().enumerate() {
+            let (d, off) = (site.law.n_dirs(), self.joints.offsets[e]);
+            for a in 0..d {
+                for b in 0..d {
+                    s[(off + a, off + b)] -= site.law.replaced_stiffness(a, b);
+                }
+            }
+        }
+        let largest = (0..self.q).fold(0.0f64, |m, i| m.max(s[(i, i)].abs()));
+        crate::model::symmetric_eigen(s.as_ref())
+            .is_some_and(|(values, _)| values.iter().all(|&v| v.is_finite() && v > 1e-9 * largest))
     }
 
     /// Are the even harmonics pinned at zero (`R_even = x_even`, the identity in `∂R/∂x`) and
