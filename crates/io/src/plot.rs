@@ -418,14 +418,7 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
         return Err(OutputError::Plot(format!("level {} N has no points to plot", level.level_n)));
     };
     let o = output_index(p0, output)?;
-    let n = p0.outputs[o].harmonics.len().saturating_sub(1);
-    let curves = (1..=n)
-        .map(|k| Curve {
-            label: format!("harmonic {k}"),
-            points: level.points.iter().map(|p| (p.frequency_hz, p.outputs[o].harmonics[k].0)).collect(),
-            dashed: level.points.iter().map(is_unstable).collect(),
-        })
-        .collect();
+    let curves = harmonic_curves(level, o);
     Chart {
         title: format!("Harmonics of {output} at {} N", level.level_n),
         x_label: "Frequency (Hz)".into(),
@@ -435,6 +428,26 @@ pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<
         markers: Vec::new(),
     }
     .render(path)
+}
+
+/// The curves of harmonics 1..N of output `o`. A harmonic that is zero at every point (the
+/// even harmonics of a half-wave symmetric response, which a balance of sliders pins at zero)
+/// has no line on a log axis: its label says so, rather than leave a colour in the legend
+/// without a line.
+fn harmonic_curves(level: &LevelResult, o: usize) -> Vec<Curve> {
+    let n = level.points.first().map_or(0, |p| p.outputs[o].harmonics.len().saturating_sub(1));
+    (1..=n)
+        .map(|k| {
+            let points: Vec<(f64, f64)> =
+                level.points.iter().map(|p| (p.frequency_hz, p.outputs[o].harmonics[k].0)).collect();
+            let zero = points.iter().all(|&(_, a)| a == 0.0);
+            Curve {
+                label: if zero { format!("harmonic {k} (zero)") } else { format!("harmonic {k}") },
+                points,
+                dashed: level.points.iter().map(is_unstable).collect(),
+            }
+        })
+        .collect()
 }
 
 /// Hysteresis loop of `element` at one point: force (N) against displacement (m), closed.
@@ -946,6 +959,26 @@ mod tests {
         // Three (1e-3 to 1e-1 inside): the decades only.
         assert_eq!(log_tick(2e-2, 8e-4, 0.2), "");
         assert_eq!(log_tick(1e-2, 8e-4, 0.2), "1e-2");
+    }
+
+    /// The even harmonics of a half-wave symmetric response are exact zeros: labelled so, the
+    /// others as they are (one of them zero at one point only).
+    #[test]
+    fn harmonics_zero_at_every_point_are_labelled_zero() {
+        use crate::output::{LevelResult, OutputRecord, PointRecord};
+        let point = |f: f64, a3: f64| PointRecord {
+            frequency_hz: f,
+            outputs: vec![OutputRecord {
+                name: "mass".into(),
+                harmonics: vec![(0.0, 0.0), (1e-3, 0.1), (0.0, 0.0), (a3, 0.2)],
+                ..OutputRecord::default()
+            }],
+            ..PointRecord::default()
+        };
+        let level =
+            LevelResult { level_n: 10.0, points: vec![point(100.0, 1e-5), point(101.0, 0.0)], ..Default::default() };
+        let labels: Vec<String> = super::harmonic_curves(&level, 0).into_iter().map(|c| c.label).collect();
+        assert_eq!(labels, ["harmonic 1", "harmonic 2 (zero)", "harmonic 3"]);
     }
 
     #[test]
