@@ -293,10 +293,7 @@ fn main() {
                 for c in 0..nc {
                     u[c] = x[c * q + e];
                 }
-                match pinned {
-                    true => aft.evaluate_half_wave(site.law.as_ref(), plan, omega, &u, &mut g, None).unwrap(),
-                    false => aft.evaluate(site.law.as_ref(), plan, omega, &u, &mut g, None).unwrap(),
-                }
+                aft.evaluate_with_symmetry(site.law.as_ref(), plan, omega, &u, &mut g, None, pinned).unwrap();
                 if complete {
                     assert!(aft.complete_slider_jacobian(plan, block.as_mut(), &mut dgdw, pinned));
                 }

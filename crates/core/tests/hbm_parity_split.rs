@@ -22,14 +22,7 @@ const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 #[test]
 fn the_split_jacobian_follows_the_same_branch_as_the_whole_matrix() {
     let n = 12;
-    let law = || Box::new(Jenkins::replacing_stiffness(4e5, 15.0).unwrap()) as Box<dyn Element>;
-    let laws: Vec<(&str, Box<dyn Element>, Vec<f64>)> = vec![
-        ("a", law(), relative_direction(n, 2, Some(3))),
-        ("b", law(), relative_direction(n, 5, Some(6))),
-        ("c", Box::new(Jenkins::new(2e5, 10.0).unwrap()), relative_direction(n, 8, None)),
-        ("d", law(), relative_direction(n, 10, Some(11))),
-    ];
-    let model = chain(n, Damping::Rayleigh { alpha: 15.0, beta: 1e-6 }, laws);
+    let model = four_slider_chain();
     let mut force = vec![0.0; n];
     force[0] = 1.0;
     let settings = HbmSettings { harmonics: 7, samples: 300 };

@@ -107,7 +107,7 @@ impl Split {
             self.w[k] = border[i];
             self.t_a[k] = t[i];
         }
-        self.solve_first(Part::W);
+        Self::solve_first(&mut self.first, self.identity, cx, &mut self.w);
         let t_w: f64 = self.t_a.iter().zip(&self.w).map(|(a, b)| a * b).sum();
         let b = &self.b;
         self.second.factor_written(nb + 1, |mut s| {
@@ -127,7 +127,7 @@ impl Split {
         for (k, &i) in self.a.iter().enumerate() {
             self.rhs_a[k] = rhs[i];
         }
-        self.solve_first(Part::Rhs);
+        Self::solve_first(&mut self.first, self.identity, self.cx, &mut self.rhs_a);
         for (k, &i) in self.b.iter().enumerate() {
             self.rhs_b[k] = rhs[i];
         }
@@ -156,7 +156,7 @@ impl Split {
         for (k, &i) in self.a.iter().enumerate() {
             self.rhs_a[k] = rhs[i];
         }
-        self.solve_first(Part::Rhs);
+        Self::solve_first(&mut self.first, self.identity, self.cx, &mut self.rhs_a);
         let nb = self.b.len();
         for (k, &i) in self.b.iter().enumerate() {
             self.rhs_b[k] = rhs[i];
@@ -170,16 +170,13 @@ impl Split {
         }
     }
 
-    /// `(c_x J_a)⁻¹` applied to `w` or to the gathered right-hand side, in place.
-    fn solve_first(&mut self, part: Part) {
-        let values = match part {
-            Part::W => &mut self.w,
-            Part::Rhs => &mut self.rhs_a,
-        };
-        if self.identity {
-            values.iter_mut().for_each(|v| *v /= self.cx);
+    /// `(c_x J_a)⁻¹ values` in place: by the factors `first`, or, for an `identity` block, a
+    /// division by `c_x`.
+    fn solve_first(first: &mut PivotedLu, identity: bool, cx: f64, values: &mut [f64]) {
+        if identity {
+            values.iter_mut().for_each(|v| *v /= cx);
         } else {
-            self.first.solve(values);
+            first.solve(values);
         }
     }
 
@@ -192,12 +189,6 @@ impl Split {
         let s = self.second.determinant();
         Determinant { sign: a.sign * s.sign, ln_abs: a.ln_abs + s.ln_abs }
     }
-}
-
-/// Which vector of a [`Split`] its first block's solve is applied to.
-enum Part {
-    W,
-    Rhs,
 }
 
 /// `block = c_x jacobian[rows, rows]`.

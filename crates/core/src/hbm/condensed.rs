@@ -257,7 +257,7 @@ impl<'m> CondensedHbm<'m> {
     }
 
     /// Are the even harmonics pinned at zero (`R_even = x_even`, the identity in `∂R/∂x`) and
-    /// the joints' forces evaluated over half a period ([`ElementAft::evaluate_half_wave`])?
+    /// the joints' forces evaluated over half a period ([`ElementAft::evaluate_with_symmetry`])?
     /// Where the balance's solutions are half-wave symmetric, until an evaluation at an `x`
     /// with an even harmonic (a guess from elsewhere; a continuation started from the linear
     /// or stuck response keeps them exactly zero), after which the balance is the whole one.
@@ -383,8 +383,10 @@ impl<'m> CondensedHbm<'m> {
         // Harmonic 0: R_0 = x_0 + H(0) G_0 (pinned: R_0 = x_0).
         for i in 0..q {
             let mut r = x[i];
-            for j in (0..q).filter(|_| !pinned) {
-                r += self.h0[(i, j)] * self.joints.g[j];
+            if !pinned {
+                for j in 0..q {
+                    r += self.h0[(i, j)] * self.joints.g[j];
+                }
             }
             residual[i] = r;
         }

@@ -178,28 +178,15 @@ impl ElementAft {
         self.evaluate_with_symmetry(law, plan, omega, u_coeffs, g_coeffs, jacobian, false)
     }
 
-    /// [`Self::evaluate`] of a half-wave symmetric motion, `u(t + T/2) = −u(t)` (its even
-    /// harmonics are not read): for a slider (an odd law) with an even number of samples, the
-    /// samples of the odd harmonics by [`AftPlan::synthesize_half_wave`], exactly symmetric,
-    /// half a period marched from the periodic start and the other half its negative (the
-    /// return mapping is odd, so marching it gives the same values, bit for bit), and the
-    /// force harmonics from the first half ([`AftPlan::analyze_half_wave`]: the even ones
-    /// zero). Other laws as [`Self::evaluate`].
+    /// [`Self::evaluate`], and with `half_wave` of a half-wave symmetric motion, `u(t + T/2) =
+    /// −u(t)` (its even harmonics are not read): for a slider (an odd law) with an even number
+    /// of samples, the samples of the odd harmonics by [`AftPlan::synthesize_half_wave`],
+    /// exactly symmetric, half a period marched from the periodic start and the other half its
+    /// negative (the return mapping is odd, so marching it gives the same values, bit for
+    /// bit), and the force harmonics from the first half ([`AftPlan::analyze_half_wave`]: the
+    /// even ones zero). Other laws as [`Self::evaluate`].
     #[allow(clippy::too_many_arguments)]
-    pub fn evaluate_half_wave(
-        &mut self,
-        law: &dyn Element,
-        plan: &AftPlan,
-        omega: f64,
-        u_coeffs: &[f64],
-        g_coeffs: &mut [f64],
-        jacobian: Option<(MatMut<'_, f64>, &mut [f64])>,
-    ) -> Result<(), AftError> {
-        self.evaluate_with_symmetry(law, plan, omega, u_coeffs, g_coeffs, jacobian, true)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn evaluate_with_symmetry(
+    pub fn evaluate_with_symmetry(
         &mut self,
         law: &dyn Element,
         plan: &AftPlan,
@@ -214,13 +201,9 @@ impl ElementAft {
         // Samples of u and, for a law that reads them, du/dθ (Eq. 15, DFT⁻¹). A rate-independent
         // law never sees its velocity: one inverse transform per direction instead of two.
         let velocity = law.depends_on_velocity();
-        let half_wave = half_wave
-            && plan.has_half_wave()
-            && law.odd_symmetric()
-            && law.slider_stiffness().is_some()
-            && d == 1
-            && s == 1
-            && !velocity;
+        // Closed-form Jacobian for sliders (module docs); the generic chain rule otherwise.
+        let slider = law.slider_stiffness().filter(|_| d == 1 && s == 1 && !velocity);
+        let half_wave = half_wave && plan.has_half_wave() && law.odd_symmetric() && slider.is_some();
         for a in 0..d {
             for c in 0..nc {
                 self.coeff_buf[c] = u_coeffs[c * d + a];
@@ -240,8 +223,6 @@ impl ElementAft {
         }
         let want_jac = jacobian.is_some();
         let cols = nc * d + 1;
-        // Closed-form Jacobian for sliders (module docs); the generic chain rule otherwise.
-        let slider = law.slider_stiffness().filter(|_| d == 1 && s == 1 && !velocity);
         let chain_rule = want_jac && slider.is_none();
 
         // Where the march starts, in which state, and the state's sensitivity to X through
@@ -285,7 +266,7 @@ impl ElementAft {
             if chain_rule {
                 self.sens_period_start.copy_from_slice(&self.sens);
             }
-            if slider.is_some() && half_wave && known.is_some() {
+            if half_wave && known.is_some() {
                 // Half a period and one sample marched (the first sample alone, for the state
                 // after it), the rest the negative of the marched half: the state after the
                 // period's last sample is the negative of the state after the half's last.
@@ -800,7 +781,7 @@ mod tests {
                 let (mut whole, mut half) = (ElementAft::new(&law, &plan), ElementAft::new(&law, &plan));
                 let (mut g_whole, mut g_half) = (vec![0.0; nc], vec![0.0; nc]);
                 whole.evaluate(&law, &plan, 1500.0, &u, &mut g_whole, None).unwrap();
-                half.evaluate_half_wave(&law, &plan, 1500.0, &u, &mut g_half, None).unwrap();
+                half.evaluate_with_symmetry(&law, &plan, 1500.0, &u, &mut g_half, None, true).unwrap();
                 assert_eq!(whole.slipping, half.slipping, "phase {phase}");
                 assert!(half.slipping.iter().any(|&s| s) && !half.slipping.iter().all(|&s| s));
                 let largest = g_whole.iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -53,7 +53,7 @@ impl JointForces {
     /// AFT of every element for the motion `x` (harmonics on the directions, coefficient-major)
     /// at Ω: `G` and, if `want`, `∂G/∂Ω` and each element's block of `∂G/∂x` (else `∂G/∂Ω`
     /// is zeroed). With `half_wave`, `x` is half-wave symmetric (its even harmonics are not
-    /// read) and each element's AFT may use it ([`ElementAft::evaluate_half_wave`]).
+    /// read) and each element's AFT may use it ([`ElementAft::evaluate_with_symmetry`]).
     pub fn evaluate(
         &mut self,
         model: &NonlinearModel,
@@ -73,11 +73,8 @@ impl JointForces {
                 }
             }
             let jac = if want { Some((self.elem_jac[e].as_mut(), &mut self.elem_dgdw[e][..])) } else { None };
-            let (aft, law, u, g) = (&mut self.afts[e], site.law.as_ref(), &self.elem_u[e], &mut self.elem_g[e]);
-            match half_wave {
-                true => aft.evaluate_half_wave(law, plan, omega, u, g, jac)?,
-                false => aft.evaluate(law, plan, omega, u, g, jac)?,
-            }
+            let (u, g) = (&self.elem_u[e], &mut self.elem_g[e]);
+            self.afts[e].evaluate_with_symmetry(site.law.as_ref(), plan, omega, u, g, jac, half_wave)?;
             for c in 0..nc {
                 for a in 0..d {
                     let row = c * q + off + a;

@@ -108,18 +108,14 @@ impl Stability {
     /// −α/2, and round-off alone would otherwise choose among them, so that the imaginary part
     /// written for a point could change from one run or build to the next.
     pub fn leading(&self) -> c64 {
-        let Some(first) = self.exponents.first() else { return c64::new(f64::NEG_INFINITY, 0.0) };
-        let largest_re = self.exponents.iter().fold(first.re, |m, s| m.max(s.re));
+        let largest_re = self.exponents.iter().fold(f64::NEG_INFINITY, |m, s| m.max(s.re));
         let tie = LEADING_TIE * self.exponents.iter().fold(0.0f64, |m, s| m.max(s.im.abs()));
-        let smaller = |a: &c64, b: &c64| a.im.abs() < b.im.abs() || (a.im.abs() == b.im.abs() && a.im > b.im);
         self.exponents
             .iter()
+            .copied()
             .filter(|s| s.re >= largest_re - tie)
-            .fold(None::<c64>, |best, s| match best {
-                Some(b) if !smaller(s, &b) => Some(b),
-                _ => Some(*s),
-            })
-            .unwrap_or(*first)
+            .min_by(|a, b| a.im.abs().total_cmp(&b.im.abs()).then(b.im.total_cmp(&a.im)))
+            .unwrap_or(c64::new(f64::NEG_INFINITY, 0.0))
     }
 
     /// Stable when every exponent has a negative real part, up to `tolerance` (1/s).
@@ -235,7 +231,7 @@ impl Hill {
             let n = matrix.nrows();
             let failed = StabilityError::Eigen { size: n };
             // A real Hill matrix (a periodic Jacobian) is solved as such: half the work.
-            let eigenvalues = if matrix.col_iter().all(|col| col.iter().all(|v| v.im == 0.0)) {
+            let eigenvalues = if is_real(&matrix) {
                 let mut real = Mat::from_fn(n, n, |i, j| matrix[(i, j)].re);
                 balance(&mut real, |v| v * v);
                 real_eigenvalues(real).ok_or_else(|| failed.clone())?
@@ -308,7 +304,7 @@ impl Hill {
             // A real matrix about a real shift has its conjugate as near: the one above the
             // axis, as [`nearer`] orders them (the Ritz values are conjugate only to their
             // convergence, not to the tie's round-off).
-            if s.im == 0.0 && theta.im < 0.0 && matrix.col_iter().all(|c| c.iter().all(|v| v.im == 0.0)) {
+            if s.im == 0.0 && theta.im < 0.0 && is_real(&matrix) {
                 theta = theta.conj();
             }
             if nearest.is_none_or(|best| nearer(theta, best, s).is_lt()) {
@@ -736,6 +732,11 @@ fn balance<T: Copy + std::ops::MulAssign<f64>>(a: &mut Mat<T>, abs2: impl Fn(T) 
             return;
         }
     }
+}
+
+/// Are all the entries of `m` real?
+fn is_real(m: &Mat<c64>) -> bool {
+    m.col_iter().all(|col| col.iter().all(|v| v.im == 0.0))
 }
 
 /// A block of Hill's companion matrix and the parity of its harmonics (`None`: the whole).
