@@ -84,10 +84,15 @@ const CANDIDATE: f64 = 2e-4;
 /// the tolerance; the solve saves the Jacobian and evaluation that would only polish it (most
 /// of the scan's points on Table 6). The located point itself is converged to round-off.
 const SCAN_PRECISION: f64 = 1e-9;
-/// A side of the scan stops after two consecutive points this fraction below the best: twice
-/// CANDIDATE, so that an arc whose top is within CANDIDATE of the best (its scanned points
-/// within CANDIDATE and ~4e-5 of it) is never left out.
-const DROP: f64 = 2.0 * CANDIDATE;
+/// CANDIDATE is for the roughest tops seen (the arcs of Table 6 and Harmony). A top whose
+/// scanned values are smooth needs less: its arcs' tops lie within the scan's ripple of their
+/// envelope, so the threshold follows the ripple measured on the lattice ([`ripple`]),
+/// RIPPLE_MARGIN times it, down to CANDIDATE_FLOOR: a hundred times the precision of the
+/// located values (~1e-7 at the tolerance of 1e-5). A side of the scan stops after two
+/// consecutive points lie more than twice the threshold below the best, so that an arc whose
+/// top is within the threshold of the best is never left out.
+const RIPPLE_MARGIN: f64 = 8.0;
+const CANDIDATE_FLOOR: f64 = 1e-5;
 
 /// Locate the maximum of `quantity(problem, x, λ)` along the branch of `problem` between
 /// `before` and `after`, given `middle`, a converged point between them where the quantity is
@@ -307,19 +312,26 @@ impl Bracket {
             ((vertex.max(sm) + WINDOW) / SCAN_SPACING).floor() as i64,
         );
         // Scanned outward from the vertex, each side until the window's end or until two
-        // consecutive points lie more than DROP below the best: the peak's flank, where no arc
-        // can rise to within CANDIDATE of the top.
+        // consecutive points fall to more than twice the candidate threshold below the best:
+        // the peak's flank, where no arc can rise to within the threshold of the top.
         let centre = ((vertex / SCAN_SPACING).round() as i64).clamp(first, last);
         let mut top = fm;
+        // The scanned values by lattice index, for the ripple.
+        let mut scanned: BTreeMap<i64, f64> = BTreeMap::new();
         for side in [1i64, -1] {
-            let mut low = 0;
+            let (mut low, mut previous) = (0, f64::INFINITY);
             let mut k = if side == 1 { centre } else { centre - 1 };
             while (first..=last).contains(&k) && low < 2 {
                 if lattice(k) > 0.0 && lattice(k) < 1.0 {
                     let value = value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?;
                     samples.push((lattice(k), value));
+                    scanned.insert(k, value);
                     top = top.max(value);
-                    low = if value < top - DROP * top.abs() { low + 1 } else { 0 };
+                    // Low and falling: a side that rises towards a best point beyond it (the
+                    // middle one, where the vertex was off) goes on.
+                    let drop = 2.0 * candidate(&scanned, top);
+                    low = if value < top - drop * top.abs() && value < previous { low + 1 } else { 0 };
+                    previous = value;
                 }
                 k += side;
             }
@@ -344,12 +356,15 @@ impl Bracket {
             } else {
                 break;
             };
-            samples.push((lattice(k), value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?));
+            let value = value_at(self, problem, &mut values, lattice(k), SCAN_PRECISION)?;
+            samples.push((lattice(k), value));
+            scanned.insert(k, value);
         }
         let top = samples.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        let candidate = candidate(&scanned, top);
         if top.is_finite() {
             // The arcs near the top: scanned points higher than their scanned neighbours (an
-            // end of the window is not, the bracket's ends are not scanned), within CANDIDATE
+            // end of the window is not, the bracket's ends are not scanned), within the threshold
             // of the best, highest first.
             let mut candidates: Vec<usize> = (1..samples.len() - 1)
                 .filter(|&j| {
@@ -358,7 +373,7 @@ impl Bracket {
                         && after.is_finite()
                         && here >= before
                         && here >= after
-                        && here >= top - CANDIDATE * top.abs()
+                        && here >= top - candidate * top.abs()
                 })
                 .collect();
             candidates.sort_by(|&a, &b| samples[b].1.total_cmp(&samples[a].1));
@@ -434,6 +449,40 @@ impl Bracket {
             solves: self.solves - solved_before,
         })
     }
+}
+
+/// The threshold below the best scanned value within which an arc is refined (see
+/// CANDIDATE; a side of the scan stops at twice it): RIPPLE_MARGIN times the ripple of the
+/// scanned values, between CANDIDATE_FLOOR and CANDIDATE, and CANDIDATE until four
+/// consecutive lattice points show the ripple.
+fn candidate(scanned: &BTreeMap<i64, f64>, top: f64) -> f64 {
+    ripple(scanned, top).map_or(CANDIDATE, |r| (RIPPLE_MARGIN * r).clamp(CANDIDATE_FLOOR, CANDIDATE))
+}
+
+/// The ripple of values on consecutive lattice points, relative to `top`: the largest third
+/// difference over four (a quarter of it, the size of a dip it shows). A smooth top's third
+/// differences are its third derivative times the spacing cubed, ~1e-7 of the value on the
+/// shipped examples; a corner between two arcs makes them of the size of the dip (a corner of
+/// depth d between straight sides gives third differences up to ~4 d). `None` until four
+/// consecutive points are known (or a value is not finite: a point that failed).
+fn ripple(scanned: &BTreeMap<i64, f64>, top: f64) -> Option<f64> {
+    if !(top.is_finite() && top != 0.0) {
+        return None;
+    }
+    let points: Vec<(i64, f64)> = scanned.iter().map(|(k, v)| (*k, *v)).collect();
+    let mut largest: Option<f64> = None;
+    for w in points.windows(4) {
+        if w[3].0 - w[0].0 != 3 {
+            continue;
+        }
+        let [a, b, c, d] = [w[0].1, w[1].1, w[2].1, w[3].1];
+        let third = (d - 3.0 * c + 3.0 * b - a).abs();
+        if !third.is_finite() {
+            return None;
+        }
+        largest = Some(largest.map_or(third, |l: f64| l.max(third)));
+    }
+    largest.map(|l| 0.25 * l / top.abs())
 }
 
 /// Locate a zero of `quantity(problem, x, λ)` along the branch of `problem` between two
@@ -772,6 +821,41 @@ mod tests {
     /// The scan's lattice around `centre`.
     fn lattice(centre: f64) -> Vec<f64> {
         (-3..=3).map(|k| centre + k as f64 * SCAN_SPACING).collect()
+    }
+
+    #[test]
+    fn the_candidate_threshold_follows_the_ripple_of_the_scan() {
+        let scan = |f: &dyn Fn(f64) -> f64| -> BTreeMap<i64, f64> {
+            (10..=30).map(|k| (k, f(k as f64 * SCAN_SPACING))).collect()
+        };
+        // A smooth top (the parabola of a resonance, 1e-3 of the value over the scan): third
+        // differences vanish to round-off, the threshold is the floor.
+        let smooth = scan(&|s| 1.0 - 0.01 * (s - 0.4) * (s - 0.4));
+        assert!(ripple(&smooth, 1.0).unwrap() < 1e-15);
+        assert_eq!(candidate(&smooth, 1.0), CANDIDATE_FLOOR);
+        // The same top with arcs 0.1 wide whose corners dip 3e-5 below their tops (smaller
+        // than Table 6's): the lattice's points nearest each top lie a tenth of an arc from
+        // it, 0.2 of the depth below, and that is what the ripple measures. The threshold is
+        // RIPPLE_MARGIN times it, above the floor.
+        let depth = 3e-5;
+        let rough = scan(&|s| {
+            let phase = (s / 0.1).fract();
+            1.0 - 0.01 * (s - 0.4) * (s - 0.4) - depth * (2.0 * (phase - 0.5).abs())
+        });
+        let r = ripple(&rough, 1.0).unwrap();
+        assert!((r - 0.2 * depth).abs() < 1e-3 * depth, "ripple {r:e} for dips of {depth:e}");
+        assert_eq!(candidate(&rough, 1.0), RIPPLE_MARGIN * r);
+        // Arcs dipping 2e-4 (Table 6's scans show dips of 1e-4 at 1000 N) keep the threshold
+        // of the roughest tops.
+        let deep = scan(&|s| 1.0 - 2e-4 * (2.0 * ((s / 0.1).fract() - 0.5).abs()));
+        assert_eq!(candidate(&deep, 1.0), CANDIDATE);
+        // Fewer than four consecutive points, or a point that failed: no measure, the most
+        // cautious threshold.
+        let gappy: BTreeMap<i64, f64> = [(1, 1.0), (2, 1.0), (4, 1.0), (5, 1.0)].into();
+        assert_eq!(candidate(&gappy, 1.0), CANDIDATE);
+        let mut failed = smooth.clone();
+        failed.insert(20, f64::NEG_INFINITY);
+        assert_eq!(candidate(&failed, 1.0), CANDIDATE);
     }
 
     #[test]
