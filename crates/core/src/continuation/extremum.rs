@@ -87,10 +87,10 @@ const SCAN_PRECISION: f64 = 1e-9;
 /// CANDIDATE is for the roughest tops seen (the arcs of Table 6 and Harmony). A top whose
 /// scanned values are smooth needs less: its arcs' tops lie within the scan's ripple of their
 /// envelope, so the threshold follows the ripple measured on the lattice ([`ripple`]),
-/// RIPPLE_MARGIN times it, down to CANDIDATE_FLOOR: a hundred times the precision of the
-/// located values (~1e-7 at the tolerance of 1e-5). A side of the scan stops after two
-/// consecutive points lie more than twice the threshold below the best, so that an arc whose
-/// top is within the threshold of the best is never left out.
+/// RIPPLE_MARGIN times it, down to CANDIDATE_FLOOR: a thousand times the precision of the
+/// located values (~1e-8 at the tolerance of 1e-5). A side of the scan stops after two
+/// consecutive points fall to more than twice the threshold below the best, so that an arc
+/// whose top is within the threshold of the best is never left out.
 const RIPPLE_MARGIN: f64 = 8.0;
 const CANDIDATE_FLOOR: f64 = 1e-5;
 
@@ -459,23 +459,25 @@ fn candidate(scanned: &BTreeMap<i64, f64>, top: f64) -> f64 {
     ripple(scanned, top).map_or(CANDIDATE, |r| (RIPPLE_MARGIN * r).clamp(CANDIDATE_FLOOR, CANDIDATE))
 }
 
-/// The ripple of values on consecutive lattice points, relative to `top`: the largest third
-/// difference over four (a quarter of it, the size of a dip it shows). A smooth top's third
-/// differences are its third derivative times the spacing cubed, ~1e-7 of the value on the
-/// shipped examples; a corner between two arcs makes them of the size of the dip (a corner of
-/// depth d between straight sides gives third differences up to ~4 d). `None` until four
-/// consecutive points are known (or a value is not finite: a point that failed).
+/// The ripple of values on consecutive lattice points, relative to `top`: a quarter of the
+/// largest third difference over four, which is the most a scanned point can lie below the
+/// top of its arc. A corner between sides of slopes ±m, sampled every h, makes third
+/// differences up to 2 m h, four times the m h / 2 by which the nearest lattice point can miss
+/// the corner; a smooth top's are its third derivative times h³. `None` until four consecutive
+/// points are known (or a value is not finite: a point that failed).
 fn ripple(scanned: &BTreeMap<i64, f64>, top: f64) -> Option<f64> {
     if !(top.is_finite() && top != 0.0) {
         return None;
     }
-    let points: Vec<(i64, f64)> = scanned.iter().map(|(k, v)| (*k, *v)).collect();
+    let mut window = [(i64::MIN, 0.0); 4];
     let mut largest: Option<f64> = None;
-    for w in points.windows(4) {
-        if w[3].0 - w[0].0 != 3 {
+    for (&k, &v) in scanned {
+        window.rotate_left(1);
+        window[3] = (k, v);
+        if window[0].0 == i64::MIN || window[3].0 - window[0].0 != 3 {
             continue;
         }
-        let [a, b, c, d] = [w[0].1, w[1].1, w[2].1, w[3].1];
+        let [a, b, c, d] = window.map(|p| p.1);
         let third = (d - 3.0 * c + 3.0 * b - a).abs();
         if !third.is_finite() {
             return None;
