@@ -52,6 +52,10 @@ const MAX_ARC_STEPS: usize = 60;
 /// where the slopes of their two segments differ by at most this fraction: a few per cent along
 /// a friction peak's side, ~100 % around a smooth top.
 const ALIGNED: f64 = 0.25;
+/// The best point's neighbours are lopsided when one lies this many times further than the
+/// other: the parabola of the arc search is then taken on the near side
+/// ([`next_arc_point`]).
+const ASYMMETRIC: f64 = 4.0;
 /// A point solved for another quantity of the bracket shows an arc this quantity's search
 /// missed where it is higher than all this quantity's own points by more than this fraction.
 const MISSED_ARC: f64 = 1e-7;
@@ -772,11 +776,31 @@ fn next_arc_point(values: &BTreeMap<u64, (f64, f64)>, a: f64, b: f64, tolerance:
             [rising.flatten(), falling.flatten()].into_iter().flatten().max_by(|x, y| x.1.total_cmp(&y.1)).map(|c| c.0);
     }
     if proposal.is_none() && !crowded {
-        // The parabola through the three points, if concave: its vertex.
-        let (d_lo, d_hi) = (slope(lo, best), slope(best, hi));
-        let curvature = (d_hi - d_lo) / (hi.0 - lo.0);
-        let vertex = 0.5 * (lo.0 + best.0) - d_lo / (2.0 * curvature);
-        proposal = (curvature < 0.0 && vertex > lo.0 && vertex < hi.0).then_some(vertex);
+        // The parabola through the best point and its neighbours, if concave: its vertex.
+        let vertex = |p: (f64, f64), q: (f64, f64), r: (f64, f64)| {
+            let (d_pq, d_qr) = (slope(p, q), slope(q, r));
+            let curvature = (d_qr - d_pq) / (r.0 - p.0);
+            let vertex = 0.5 * (p.0 + q.0) - d_pq / (2.0 * curvature);
+            (curvature < 0.0 && vertex > lo.0 && vertex < hi.0).then_some(vertex)
+        };
+        // Where one neighbour lies more than ASYMMETRIC times further than the other, first
+        // through the best point and the two nearest on the near side, if they span less than
+        // half the far side (as Brent's parabola goes through the best points): across the far
+        // side, a lopsided top (a steep fall beyond it) biases the vertex towards the best
+        // point, and the steps crept to the top by ever smaller fractions of the way (a
+        // smooth top of the lap joint took 14 steps). Not from a neighbour a step of about
+        // the tolerance away, whose slope to the best point near the top is round-off.
+        let wide = |gap: f64| gap > 2.5 * tolerance;
+        let near_side = if hi.0 - best.0 > ASYMMETRIC * (best.0 - lo.0) && wide(best.0 - lo.0) && k >= 2 {
+            let p = points[k - 2];
+            (inside(&p) && best.0 - p.0 < 0.5 * (hi.0 - best.0)).then(|| vertex(p, lo, best)).flatten()
+        } else if best.0 - lo.0 > ASYMMETRIC * (hi.0 - best.0) && wide(hi.0 - best.0) && k + 2 < points.len() {
+            let r = points[k + 2];
+            (inside(&r) && r.0 - best.0 < 0.5 * (best.0 - lo.0)).then(|| vertex(best, hi, r)).flatten()
+        } else {
+            None
+        };
+        proposal = near_side.or_else(|| vertex(lo, best, hi));
     }
     // Within half the tolerance of a point solved (a step of exactly the tolerance is not).
     let near = |s: f64| values.keys().any(|key| (f64::from_bits(*key) - s).abs() < 0.5 * tolerance);
@@ -966,5 +990,27 @@ mod tests {
             total_steps += steps;
         }
         assert!(total_steps <= 9 * 500, "{} steps on average", total_steps as f64 / 500.0);
+    }
+
+    #[test]
+    fn a_lopsided_smooth_top_is_located_in_a_few_steps() {
+        // A smooth top whose far side falls steeply (a cubic beyond the top: the lap joint's
+        // second peak, top near 0.6913 of the chord, the scan's best at 0.70): the parabola
+        // through the far neighbour puts each step short of the top, and the steps crept
+        // there by ever smaller fractions of the way (19 steps for the top at 0.7031, 9 at
+        // 0.6913). On the near side, a step or two, then the two of one tolerance that close
+        // the bracket.
+        for (top, quadratic, cubic) in
+            [(0.6913, 1e-4, 5e-3), (0.6913, 1e-4, 2e-3), (0.695, 1e-4, 5e-3), (0.7031, 1e-4, 5e-3)]
+        {
+            let f = |s: f64| {
+                let d = s - top;
+                1.0 - quadratic * d * d - if d > 0.0 { cubic * d * d * d } else { 0.0 }
+            };
+            let scan = lattice(0.70);
+            let (s, _, steps) = search(f, [scan[2], scan[4]], &scan, 1e-5);
+            assert!((s - top).abs() <= 1e-5, "{s} for the top at {top}");
+            assert!(steps <= 6, "{steps} steps for the top at {top}");
+        }
     }
 }
