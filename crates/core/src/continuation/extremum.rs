@@ -721,7 +721,7 @@ impl ChordPath {
 /// straight sides the corner itself, on curved ones a step or two from it; the steps then
 /// land on either side of the corner and close the bracket. Elsewhere (a smooth top, or a
 /// side that is not straight), the vertex of the parabola through the best point and its
-/// neighbours; a step is at least the tolerance, and a golden-section step of the larger side
+/// neighbours (on the near side where they are lopsided, [`ASYMMETRIC`]); a step is at least the tolerance, and a golden-section step of the larger side
 /// is taken where no model applies (Brent 1973, ch. 5, whose parabolas alone fit a corner
 /// badly: 11-15 points a corner at a tolerance of 1e-5, against 4-6 here). Written here: a
 /// bounded search over a cached, piecewise smooth function is what no optimisation crate
@@ -788,7 +788,7 @@ fn next_arc_point(values: &BTreeMap<u64, (f64, f64)>, a: f64, b: f64, tolerance:
         // half the far side (as Brent's parabola goes through the best points): across the far
         // side, a lopsided top (a steep fall beyond it) biases the vertex towards the best
         // point, and the steps crept to the top by ever smaller fractions of the way (a
-        // smooth top of the lap joint took 14 steps). Not from a neighbour a step of about
+        // smooth top of the lap joint took 21 solves, 11 now). Not from a neighbour a step of about
         // the tolerance away, whose slope to the best point near the top is round-off.
         let wide = |gap: f64| gap > 2.5 * tolerance;
         let near_side = if hi.0 - best.0 > ASYMMETRIC * (best.0 - lo.0) && wide(best.0 - lo.0) && k >= 2 {
