@@ -21,7 +21,7 @@ pub const CASE_TIME_LIMIT: Duration = Duration::from_secs(5);
 /// The proptest configuration of a fuzz target (the count printed, so that a log shows it).
 pub fn config(target: &str) -> Config {
     let cases = std::env::var("STICKSLIP_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(DEFAULT_CASES);
-    eprintln!("fuzz {target}: {cases} cases (set STICKSLIP_FUZZ_CASES for more)");
+    show(&format!("fuzz {target}: {cases} cases (set STICKSLIP_FUZZ_CASES for more)"));
     Config {
         cases,
         // Failures are reported with the input; no regression files are written beside the tests.
@@ -205,5 +205,13 @@ pub fn fuzz(target: &str, seeds: &[Vec<u8>], check: impl Fn(usize, &[u8])) {
             Ok(())
         })
         .unwrap_or_else(|e| panic!("fuzz {target}: {e}"));
-    eprintln!("fuzz {target}: done in {:.1} s", started.elapsed().as_secs_f64());
+    show(&format!("fuzz {target}: {} cases done in {:.2} s", runner.config().cases, started.elapsed().as_secs_f64()));
+}
+
+/// A line on the test's standard error that `cargo test` shows: it captures what `eprintln!`
+/// writes in a passing test, not what is written to the stream itself, and a log should show
+/// each target's cases and time.
+fn show(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
 }
