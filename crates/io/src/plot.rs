@@ -783,6 +783,7 @@ fn draw_comparison<DB: DrawingBackend>(
     }
     // Finite axis ends whatever the data (see `AXIS_LIMIT`).
     let (x, y) = (linear_axis(x0, x1), log_axis(y0, y1));
+    let (ly0, ly1) = (y.start, y.end);
     root.fill(&WHITE).map_err(e)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, (FONT, 22))
@@ -795,7 +796,7 @@ fn draw_comparison<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("Frequency (Hz)")
         .y_desc(format!("|FRF| ({})", unit_text(unit)))
-        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .y_label_formatter(&|y| log_tick(*y, ly0, ly1))
         .label_style((FONT, 15))
         .draw()
         .map_err(e)?;
@@ -839,6 +840,7 @@ fn draw_against_amplitude<DB: DrawingBackend>(
     let (y0, y1) = min_max(kept.iter().map(|p| p.1));
     let x = if kept.is_empty() { 1e-6..1.0 } else { a0.max(f64::MIN_POSITIVE) * 1.05..a1 * 1.05 };
     let x = log_axis(x.start / 1.05, x.end / 1.05);
+    let (lx0, lx1) = (x.start, x.end);
     let (y0, y1) = if kept.is_empty() { (0.0, 1.0) } else { (y0, y1) };
     let pad = 0.05 * (y1 - y0).max(1e-3 * y0.abs().max(y1.abs())).max(f64::MIN_POSITIVE);
     let y = linear_axis(y0 - pad, y1 + pad);
@@ -854,7 +856,7 @@ fn draw_against_amplitude<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("modal amplitude (m·√kg)")
         .y_desc(y_label)
-        .x_label_formatter(&|a| format!("{a:.0e}"))
+        .x_label_formatter(&|a| log_tick(*a, lx0, lx1))
         .y_label_formatter(&|v| tick(*v, span))
         .label_style((FONT, 15))
         .draw()
@@ -938,6 +940,52 @@ pub fn plot_backbone(
 
 #[cfg(test)]
 mod tests {
+    /// The tick labels in exponent form of an SVG plot.
+    fn exponent_labels(svg: &str) -> Vec<String> {
+        svg.split('>')
+            .filter_map(|t| t.split('<').next())
+            .map(str::trim)
+            .filter(|t| t.contains('e') && t.parse::<f64>().is_ok())
+            .map(String::from)
+            .collect()
+    }
+
+    #[test]
+    fn the_comparison_and_backbone_log_axes_label_their_decades() {
+        // Five decades: the decades alone are labelled (as every log axis of the FRF plots);
+        // about one: the ticks at 1, 2 and 5 too, so that values can be read, not all nine.
+        let dir = std::env::temp_dir().join(format!("stickslip-plot-decades-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (decades, name) in [(5.0, "five"), (0.9, "one")] {
+            let f: Vec<f64> = (0..200).map(|i| 10.0 + i as f64).collect();
+            let a: Vec<f64> = f.iter().map(|x| 1e-6 * 10f64.powf(decades * (x - 10.0) / 199.0)).collect();
+            let measured = [super::MeasuredCurve { label: "m".into(), frequency_hz: f.clone(), amplitude: a.clone() }];
+            let compared = dir.join(format!("compare_{name}.svg"));
+            super::plot_comparison(&compared, "tip at 1 N", "m_per_N", &(f, a), &measured).unwrap();
+            let backbone = dir.join(format!("backbone_{name}.svg"));
+            let points: Vec<(f64, f64)> =
+                (0..50).map(|i| (1e-6 * 10f64.powf(decades * i as f64 / 49.0), 100.0 - i as f64)).collect();
+            super::render_against_amplitude(&backbone, "mode 1", "frequency (Hz)", &points).unwrap();
+            for path in [compared, backbone] {
+                let labels = exponent_labels(&std::fs::read_to_string(&path).unwrap());
+                let decade = |l: &String| l.starts_with("1e");
+                if decades > 3.0 {
+                    assert!(labels.len() >= 4 && labels.iter().all(decade), "{}: {labels:?}", path.display());
+                } else {
+                    // Not every tick plotters places (1e-6, 2e-6, 3e-6, ..., 9e-6: crowded, as
+                    // the formatter of before labelled them).
+                    let readable = |l: &String| ["1e", "2e", "5e"].iter().any(|m| l.starts_with(m));
+                    assert!(
+                        labels.len() >= 4 && labels.iter().all(readable) && !labels.iter().all(decade),
+                        "{}: {labels:?}",
+                        path.display()
+                    );
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn log_axes_label_the_decades_or_enough_ticks_to_read_values_by() {
         use super::log_tick;

@@ -169,3 +169,22 @@ fn npz_round_trip() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text, "index,name,node,direction,full_index\n0,12.3,12,3,4\n1,40.1,40,1,0\n2,mode1,,,\n");
 }
+
+#[test]
+fn npz_refuses_a_basis_that_is_not_finite_and_writes_nothing() {
+    let model = LinearModel::new(
+        Matrix::Dense(Mat::identity(2, 2)),
+        Matrix::Dense(Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { -1.0 })),
+        Damping::None,
+        vec![DofLabel::nodal(1, 1), DofLabel::nodal(2, 1)],
+        vec![],
+    )
+    .unwrap();
+    let mut t = Mat::from_fn(4, 2, |i, j| (i + j) as f64);
+    t[(2, 1)] = f64::NAN;
+    let path = scratch("not_finite.npz");
+    let _ = std::fs::remove_file(&path);
+    let e = npz::write(&path, &model, &npz::NpzExtras { basis: Some(&t), retained: &[0, 1] }).unwrap_err().to_string();
+    assert!(e.contains("not_finite.npz") && e.contains("T holds NaN at row 3, column 2: refusing to write"), "{e}");
+    assert!(!path.exists(), "a half-written archive was left");
+}

@@ -141,3 +141,22 @@ fn inline_bad_files() {
     }
     assert!(matches!(mtx::read(&scratch("absent.mtx")), Err(MatrixFileError::Io { .. })));
 }
+
+#[test]
+fn matrices_that_are_not_finite_are_refused_naming_the_entry() {
+    let mut dense = Mat::from_fn(3, 3, |i, j| (i + 2 * j) as f64);
+    dense[(1, 2)] = f64::INFINITY;
+    let sparse = Matrix::Sparse(
+        SparseColMat::try_new_from_triplets(3, 3, &[Triplet::new(0, 0, 1.0), Triplet::new(2, 1, f64::NAN)]).unwrap(),
+    );
+    for (name, m, entry) in [
+        ("inf.mtx", Matrix::Dense(dense), "holds inf at row 2, column 3"),
+        ("nan.mtx", sparse, "holds NaN at row 3, column 2"),
+    ] {
+        let path = scratch(name);
+        let _ = std::fs::remove_file(&path);
+        let e = mtx::write(&path, &m).unwrap_err().to_string();
+        assert!(e.contains(name) && e.contains(entry) && e.contains("refusing to write"), "{e}");
+        assert!(!path.exists(), "{name} written");
+    }
+}

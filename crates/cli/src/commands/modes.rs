@@ -325,6 +325,18 @@ pub fn main(args: Args) -> anyhow::Result<()> {
     if let Some(r) = (0..freqs.len()).find(|&r| !(freqs[r].is_finite() && sol.residuals[r].is_finite())) {
         bail!("mode {}: frequency {} Hz, residual {}: not finite, nothing written", r + 1, freqs[r], sol.residuals[r]);
     }
+    // Nor shapes (modes.vtk, shapes.csv) or effective masses holding a value that is not finite.
+    let shapes = &sol.modes.shapes;
+    if let Some((i, r)) = (0..shapes.ncols())
+        .flat_map(|r| (0..shapes.nrows()).map(move |i| (i, r)))
+        .find(|&(i, r)| !shapes[(i, r)].is_finite())
+    {
+        let dof = model.dofs.get(i).map_or_else(|| format!("{}", i + 1), |d| d.name.clone());
+        bail!("mode {}: its shape is {} at DOF {dof}: not finite, nothing written", r + 1, shapes[(i, r)]);
+    }
+    if let Some((r, e)) = eff.iter().flatten().enumerate().find(|(_, e)| e.iter().any(|v| !v.is_finite())) {
+        bail!("mode {}: effective masses {e:?} kg: not finite, nothing written", r + 1);
+    }
     let mut table = String::new();
     table.push_str("mode,frequency_hz,eff_mass_x_kg,eff_mass_y_kg,eff_mass_z_kg,residual\n");
     println!(

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use faer::sparse::{SparseColMat, Triplet};
+use faer::MatRef;
 use stickslip_core::model::{Damping, DofLabel, LinearModel, Matrix, ModelError};
 
 pub mod abaqus;
@@ -27,6 +28,47 @@ pub enum MatrixFileError {
     Parse { path: PathBuf, line: usize, message: String },
     #[error("{}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
+}
+
+/// Refuse to write `matrix` (named `name` in the message) to `path` if an entry is not finite,
+/// naming the first such entry (1-based row and column, as Matrix Market counts): a file that
+/// holds NaN or inf reads back as nothing any solver can use, and every reader here refuses it.
+pub(crate) fn refuse_non_finite(path: &Path, name: &str, matrix: &Matrix) -> Result<(), MatrixFileError> {
+    let first = match matrix {
+        Matrix::Dense(m) => first_non_finite(m.as_ref()),
+        Matrix::Sparse(m) => {
+            let m = m.as_ref();
+            (0..m.ncols())
+                .flat_map(|j| {
+                    m.symbolic().row_idx_of_col_raw(j).iter().zip(m.val_of_col(j)).map(move |(&i, &v)| (i, j, v))
+                })
+                .find(|e| !e.2.is_finite())
+        }
+    };
+    refuse_entry(path, name, first)
+}
+
+/// [`refuse_non_finite`] for a dense matrix (a reduction basis, which is not copied to check it).
+pub(crate) fn refuse_non_finite_dense(path: &Path, name: &str, m: MatRef<'_, f64>) -> Result<(), MatrixFileError> {
+    refuse_entry(path, name, first_non_finite(m))
+}
+
+fn first_non_finite(m: MatRef<'_, f64>) -> Option<(usize, usize, f64)> {
+    (0..m.ncols()).flat_map(|j| (0..m.nrows()).map(move |i| (i, j, m[(i, j)]))).find(|e| !e.2.is_finite())
+}
+
+fn refuse_entry(path: &Path, name: &str, entry: Option<(usize, usize, f64)>) -> Result<(), MatrixFileError> {
+    match entry {
+        Some((i, j, v)) => Err(MatrixFileError::invalid(
+            path,
+            format!(
+                "{name} holds {v} at row {}, column {}: refusing to write a value that is not finite",
+                i + 1,
+                j + 1
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 impl MatrixFileError {

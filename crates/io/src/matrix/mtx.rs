@@ -223,6 +223,7 @@ fn read_array<'a>(
 /// (lower triangle only) when the matrix is exactly symmetric, else `general`. Values are
 /// written with the shortest decimal form that reads back to the same `f64`.
 pub fn write(path: &Path, matrix: &Matrix) -> Result<(), MatrixFileError> {
+    super::refuse_non_finite(path, "the matrix", matrix)?;
     let file = std::fs::File::create(path).map_err(|e| MatrixFileError::io(path, e))?;
     let mut w = std::io::BufWriter::new(file);
     write_to(&mut w, matrix).and_then(|_| w.flush()).map_err(|e| MatrixFileError::io(path, e))

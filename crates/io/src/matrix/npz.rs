@@ -23,6 +23,15 @@ pub struct NpzExtras<'a> {
 /// Write `M`, `K`, `D` (if a damping matrix), the DOF map and the extras.
 pub fn write(path: &Path, model: &LinearModel, extras: &NpzExtras<'_>) -> Result<(), MatrixFileError> {
     let io = |e: std::io::Error| MatrixFileError::io(path, e);
+    // Checked before the file is created, so that nothing is left half written.
+    super::refuse_non_finite(path, "M", &model.mass)?;
+    super::refuse_non_finite(path, "K", &model.stiffness)?;
+    if let Damping::Matrix(d) = &model.damping {
+        super::refuse_non_finite(path, "D", d)?;
+    }
+    if let Some(t) = extras.basis {
+        super::refuse_non_finite_dense(path, "T", t.as_ref())?;
+    }
     let mut npz = NpzFile::create(path).map_err(io)?;
     let mut dense = |name: &str, m: &Mat<f64>| {
         let shape = [m.nrows() as u64, m.ncols() as u64];

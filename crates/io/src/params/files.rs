@@ -79,15 +79,18 @@ pub fn rows(outcome: &SampleOutcome) -> String {
             write!(out, ",{v:e}").expect("String write");
         }
     };
+    // A level without points has no peak: its fields are left empty (as a failed sample's are),
+    // with `points` 0 and the ending saying why, rather than written as NaN.
+    let number = |v: f64| if v.is_finite() { format!("{v:e}") } else { String::new() };
     for r in &outcome.rows {
         start(&mut out);
         writeln!(
             out,
-            ",{:e},{:e},{:e},{:e},{},{},{},",
+            ",{:e},{},{},{},{},{},{},",
             r.level_n,
-            r.peak_frequency_hz,
-            r.peak_amplitude_m,
-            r.peak_energy_j,
+            number(r.peak_frequency_hz),
+            number(r.peak_amplitude_m),
+            number(r.peak_energy_j),
             r.points,
             r.complete,
             quote(&r.ending)
@@ -262,4 +265,35 @@ fn read_shard(path: &Path) -> Result<ShardFile, ParamError> {
         return Err(bad("the file ends inside a quoted field".into()));
     }
     Ok(ShardFile { path: path.to_path_buf(), study, design, shard, samples, header, rows })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::SummaryRow;
+
+    #[test]
+    fn a_level_without_a_peak_leaves_its_fields_empty_rather_than_nan() {
+        let row = |f: f64| SummaryRow {
+            level_n: 10.0,
+            peak_frequency_hz: f,
+            peak_amplitude_m: if f.is_nan() { f64::NAN } else { 1e-3 },
+            peak_energy_j: if f.is_nan() { f64::NAN } else { 0.5 },
+            points: if f.is_nan() { 0 } else { 40 },
+            complete: !f.is_nan(),
+            ending: "ended".into(),
+        };
+        let outcome = SampleOutcome {
+            index: 3,
+            values: vec![0.25],
+            rows: vec![row(120.0), row(f64::NAN)],
+            levels: None,
+            error: None,
+        };
+        let text = rows(&outcome);
+        assert!(!text.to_lowercase().contains("nan"), "{text}");
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "3,2.5e-1,1e1,1.2e2,1e-3,5e-1,40,true,\"ended\",");
+        assert_eq!(lines[1], "3,2.5e-1,1e1,,,,0,false,\"ended\",");
+    }
 }
