@@ -307,3 +307,22 @@ fn reference_decks_read_back_to_the_same_model() {
         assert_same_model(&FeModel::assemble(mesh).unwrap(), &FeModel::assemble(read).unwrap(), name);
     }
 }
+
+#[test]
+fn coordinates_that_are_not_finite_are_refused_by_both_writers() {
+    let mut mesh = box_mesh([0.1, 0.1, 0.1], [1, 1, 1], SolidKind::Hex8, STEEL);
+    mesh.nodes[3].xyz[1] = f64::NAN;
+    let id = mesh.nodes[3].id;
+    let e = gmsh_writer::to_string(&mesh).unwrap_err().to_string();
+    assert!(e.contains(&format!("node {id} has coordinates")) && e.contains("NaN"), "{e}");
+    let e = inp_writer::to_string(&mesh).unwrap_err().to_string();
+    assert!(e.contains(&format!("node {id} has coordinates")) && e.contains("NaN"), "{e}");
+    let mut mesh = box_mesh([0.1, 0.1, 0.1], [1, 1, 1], SolidKind::Hex8, STEEL);
+    mesh.materials[0].1.density = f64::INFINITY;
+    let e = inp_writer::to_string(&mesh).unwrap_err().to_string();
+    assert!(e.contains("density: inf") && e.contains("not finite"), "{e}");
+    let mut mesh = box_mesh([0.1, 0.1, 0.1], [1, 1, 1], SolidKind::Hex8, STEEL);
+    mesh.points.push(stickslip_fe::mesh::PointElement::Mass { id: 99, node: 0, mass: f64::NAN });
+    let e = inp_writer::to_string(&mesh).unwrap_err().to_string();
+    assert!(e.contains("element 99 has the value(s) [NaN], not finite"), "{e}");
+}

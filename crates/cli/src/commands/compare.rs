@@ -318,14 +318,49 @@ fn peak_table(rows: &[report::ComparedPeak]) -> (String, String) {
             r.output,
             r.unit,
             r.source,
-            mf,
-            sf,
-            sf - mf,
-            df_pct,
-            ma,
-            sa,
-            da_pct
+            cell(mf),
+            cell(sf),
+            cell(sf - mf),
+            cell(df_pct),
+            cell(ma),
+            cell(sa),
+            cell(da_pct)
         );
     }
     (text, csv)
+}
+
+/// A number of `peaks.csv`: empty where there is none (no simulated peak, or an error relative
+/// to a measured amplitude of zero), as CSV readers take a missing value, rather than NaN or
+/// inf; the table printed beside it shows them as such.
+fn cell(v: f64) -> String {
+    if v.is_finite() {
+        v.to_string()
+    } else {
+        String::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_simulated_peak_leaves_its_fields_empty_in_the_csv() {
+        let peak = |simulated: f64| report::ComparedPeak {
+            level_n: 2.0,
+            output: "tip".into(),
+            unit: "m_per_N".into(),
+            source: "test".into(),
+            measured_frequency_hz: 100.0,
+            measured_amplitude: 1e-3,
+            simulated_frequency_hz: simulated,
+            simulated_amplitude: simulated * 1e-5,
+        };
+        let (_, csv) = peak_table(&[peak(101.0), peak(f64::NAN)]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert!(!csv.to_lowercase().contains("nan") && !csv.contains("inf"), "{csv}");
+        assert!(lines[1].starts_with("2,tip,m_per_N,test,100,101,1,1,0.001,0.00101,1.0000000000"), "{}", lines[1]);
+        assert_eq!(lines[2], "2,tip,m_per_N,test,100,,,,0.001,,");
+    }
 }

@@ -67,6 +67,9 @@ struct Volume {
 
 /// The `.msh` text for `mesh`.
 pub fn to_string(mesh: &Mesh) -> Result<String, MeshError> {
+    if let Some(n) = mesh.nodes.iter().find(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+        return Err(unwritable(format!("node {} has coordinates {:?}, not finite", n.id, n.xyz)));
+    }
     let mut ids = HashSet::with_capacity(mesh.solids.len());
     for s in &mesh.solids {
         if !ids.insert(s.id) {

@@ -206,6 +206,27 @@ fn check(mesh: &Mesh) -> Result<(), MeshError> {
             return Err(MeshError::NoSection { element: s.id, kind: s.kind.abaqus_name().into() });
         }
     }
+    // A deck holding NaN or inf reads back as nothing a solver can use: refused, named.
+    if let Some(n) = mesh.nodes.iter().find(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+        return Err(unwritable(format!("node {} has coordinates {:?}, not finite", n.id, n.xyz)));
+    }
+    if let Some((name, m)) =
+        mesh.materials.iter().find(|(_, m)| [m.young, m.poisson, m.density].iter().any(|x| !x.is_finite()))
+    {
+        return Err(unwritable(format!("material {name:?} has {m:?}, not finite")));
+    }
+    for p in &mesh.points {
+        let (id, values): (u64, &[f64]) = match p {
+            PointElement::Mass { id, mass, .. } => (*id, std::slice::from_ref(mass)),
+            PointElement::Spring { id, stiffness, .. } | PointElement::AxialSpring { id, stiffness, .. } => {
+                (*id, std::slice::from_ref(stiffness))
+            }
+            PointElement::Connector { id, stiffness, .. } => (*id, stiffness),
+        };
+        if values.iter().any(|x| !x.is_finite()) {
+            return Err(unwritable(format!("element {id} has the value(s) {values:?}, not finite")));
+        }
+    }
     let mut materials = HashSet::new();
     for (name, _) in &mesh.materials {
         check_name("material", name)?;

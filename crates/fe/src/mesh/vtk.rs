@@ -26,6 +26,17 @@ pub fn write(
     solids: &[Solid],
     fields: &[(String, Vec<[f64; 3]>)],
 ) -> io::Result<()> {
+    // Nothing written where a value is not finite: ParaView would read NaN as a shape.
+    let refuse =
+        |what: String| Err(io::Error::new(io::ErrorKind::InvalidData, format!("{what}: refusing to write it")));
+    if let Some(n) = nodes.iter().position(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+        return refuse(format!("node {} has coordinates {:?}, not finite", n + 1, nodes[n].xyz));
+    }
+    for (name, values) in fields {
+        if let Some(n) = values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
+            return refuse(format!("field `{name}` is {:?} at node {}, not finite", values[n], n + 1));
+        }
+    }
     writeln!(out, "# vtk DataFile Version 3.0")?;
     writeln!(out, "{}", title.lines().next().unwrap_or(""))?;
     writeln!(out, "ASCII\nDATASET UNSTRUCTURED_GRID")?;
@@ -58,4 +69,19 @@ pub fn write(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_field_that_is_not_finite_is_refused_and_nothing_written() {
+        let nodes: Vec<Node> = (0..2).map(|i| Node { id: i + 1, xyz: [i as f64, 0.0, 0.0] }).collect();
+        let fields = vec![("mode1".to_string(), vec![[0.0, 1.0, 0.0], [0.0, f64::NAN, 0.0]])];
+        let mut out = Vec::new();
+        let e = write(&mut out, "t", &nodes, &[], &fields).unwrap_err().to_string();
+        assert!(e.contains("field `mode1` is [0.0, NaN, 0.0] at node 2, not finite: refusing to write it"), "{e}");
+        assert!(out.is_empty(), "{}", String::from_utf8_lossy(&out));
+    }
 }
