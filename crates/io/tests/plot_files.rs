@@ -260,3 +260,49 @@ fn measured_markers_are_drawn_over_the_simulated_line() {
     assert!(text.contains("m/s² / N"), "the unit on the axis");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn unstable_stretches_are_drawn_dashed_and_bifurcations_marked() {
+    use stickslip_io::output::{BifurcationRecord, PointStability};
+    let dir = scratch_dir("plot-unstable");
+    let mut levels = levels();
+    // The middle level unstable between 240 and 260 Hz, with a fold at each end.
+    let unstable = |f: f64| (240.0..=260.0).contains(&f);
+    for p in &mut levels[1].points {
+        let stable = !unstable(p.frequency_hz);
+        p.stability = Some(PointStability { stable, exponent_re: if stable { -1.0 } else { 1.0 }, exponent_im: 0.0 });
+    }
+    for f in [240.0, 260.0] {
+        // On the curve: |X₁| = (|X₁|/F) × F.
+        let on_curve = levels[1].points.iter().find(|p| p.frequency_hz == f).unwrap().outputs[0].disp_frf * 1000.0;
+        levels[1].bifurcations.push(BifurcationRecord {
+            level_n: 1000.0,
+            kind: "fold".into(),
+            frequency_hz: f,
+            amplitudes: vec![("mass".into(), on_curve)],
+            exponent_im: 0.0,
+            located: true,
+        });
+    }
+    let amplitude = plot_frfs(&dir, &levels, PlotFormat::Svg).unwrap();
+    let phase = plot_frf_phases(&dir, &levels, PlotFormat::Svg).unwrap();
+    for path in [&amplitude[0], &phase[0]] {
+        let text = svg(path);
+        // Solid, a curve is one polyline; dashed, the stretch is drawn as 8 px dashes with
+        // 6 px gaps: many more lines of the curves' width than the 3 + 3 of stable curves.
+        let wide = text.matches("stroke-width=\"2\"").count();
+        assert!(wide > 3 + 3 + 5, "{}: {wide} lines 2 px wide, no dashes", path.display());
+    }
+    let text = svg(&amplitude[0]);
+    assert!(text.contains("dashed: unstable"), "the title says what dashes mean");
+    // A marker is a ring of radius 5 with its kind's symbol beside it.
+    assert_eq!(text.matches("<circle").count(), 2, "the two folds marked");
+    assert!(text.contains("r=\"5\"") && text.contains("LP"), "the folds' rings and symbol");
+    // Without stability, the same curves are solid.
+    let stable = scratch_dir("plot-stable");
+    let text = svg(&plot_frfs(&stable, &self::levels(), PlotFormat::Svg).unwrap()[0]);
+    assert_eq!(text.matches("stroke-width=\"2\"").count(), 3 + 3);
+    assert!(!text.contains("dashed"));
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&stable).unwrap();
+}
