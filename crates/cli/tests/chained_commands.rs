@@ -146,6 +146,15 @@ fn mesh_to_comparison_each_command_reading_the_previous_ones_files() {
     let mut extract = vec![s("extract"), s("--stepped"), s("--reference"), s("force"), s("--out"), path("extract")];
     extract.extend(records);
     ok(&extract);
+    // Its FRFs plotted too, amplitude and phase per unit, as docs/outputs.md lists them.
+    let plotted: Vec<String> = std::fs::read_dir(dir.join("extract"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".svg"))
+        .collect();
+    for kind in ["frf_amp_m_per_N.svg", "frf_phase_m_per_N.svg"] {
+        assert!(plotted.iter().any(|name| name == kind), "extract drew no {kind}: {plotted:?}");
+    }
 
     // The harmonic balance and the time integration agree at the five frequencies. The first
     // harmonic of the tip: the balance keeps 7 harmonics (what the 8th and above carry is out
