@@ -67,7 +67,7 @@ struct Volume {
 
 /// The `.msh` text for `mesh`.
 pub fn to_string(mesh: &Mesh) -> Result<String, MeshError> {
-    if let Some(n) = mesh.nodes.iter().find(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+    if let Some(n) = super::non_finite_node(&mesh.nodes).map(|i| &mesh.nodes[i]) {
         return Err(unwritable(format!("node {} has coordinates {:?}, not finite", n.id, n.xyz)));
     }
     let mut ids = HashSet::with_capacity(mesh.solids.len());

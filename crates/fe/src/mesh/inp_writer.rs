@@ -207,7 +207,7 @@ fn check(mesh: &Mesh) -> Result<(), MeshError> {
         }
     }
     // A deck holding NaN or inf reads back as nothing a solver can use: refused, named.
-    if let Some(n) = mesh.nodes.iter().find(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+    if let Some(n) = super::non_finite_node(&mesh.nodes).map(|i| &mesh.nodes[i]) {
         return Err(unwritable(format!("node {} has coordinates {:?}, not finite", n.id, n.xyz)));
     }
     if let Some((name, m)) =

@@ -97,6 +97,12 @@ pub struct Node {
     pub xyz: [f64; 3],
 }
 
+/// The first node whose coordinates are not all finite, by index: what the writers refuse to
+/// write (a file holding NaN or inf reads back as nothing a solver can use).
+pub(crate) fn non_finite_node(nodes: &[Node]) -> Option<usize> {
+    nodes.iter().position(|n| n.xyz.iter().any(|x| !x.is_finite()))
+}
+
 /// A continuum element; `nodes` are indices into [`Mesh::nodes`] in Abaqus/CalculiX order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solid {

@@ -29,7 +29,7 @@ pub fn write(
     // Nothing written where a value is not finite: ParaView would read NaN as a shape.
     let refuse =
         |what: String| Err(io::Error::new(io::ErrorKind::InvalidData, format!("{what}: refusing to write it")));
-    if let Some(n) = nodes.iter().position(|n| n.xyz.iter().any(|x| !x.is_finite())) {
+    if let Some(n) = super::non_finite_node(nodes) {
         return refuse(format!("node {} has coordinates {:?}, not finite", n + 1, nodes[n].xyz));
     }
     for (name, values) in fields {
