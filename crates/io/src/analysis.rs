@@ -452,6 +452,11 @@ impl<'a> LevelSweeper<'a> {
                     kind: b.kind.name().to_string(),
                     frequency_hz: b.omega / TWO_PI,
                     amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
+                    harmonics: result
+                        .outputs
+                        .iter()
+                        .map(|o| (o.name.clone(), harmonics_from_coefficients(&o.coeffs)))
+                        .collect(),
                     exponent_im: b.exponent.map_or(0.0, |e| e.im),
                     located: b.located,
                 })
@@ -847,6 +852,30 @@ fn singular_directions(hbm: &mut CondensedHbm<'_>, x: &[f64], omega: f64, level:
 /// Say why a branch ended, for users.
 pub fn describe_termination(t: &TerminationReason) -> String {
     describe_termination_with(t, None)
+}
+
+/// Say why a backbone ended, for users: its branch is continued in `log10` of the modal
+/// amplitude, not in frequency, so its stops are said in amplitude.
+pub fn describe_backbone_termination(t: &TerminationReason) -> String {
+    let amplitude = |lambda: &f64| 10f64.powf(*lambda);
+    match t {
+        TerminationReason::ReachedEnd => "reached the last amplitude".into(),
+        TerminationReason::ReturnedToStart => {
+            "came back to amplitude_start after a fold in amplitude".into()
+        }
+        TerminationReason::MaxPoints => "stopped at [nonlinear_mode] max_points (raise it)".into(),
+        TerminationReason::FirstPointFailed { lambda, residual_norm, iterations } => format!(
+            "no convergence at the first amplitude, {:.4e} m·√kg, after {iterations} Newton iterations (residual {residual_norm:.3e}): start at a smaller amplitude_start",
+            amplitude(lambda)
+        ),
+        TerminationReason::StepTooSmall { rejection, lambda, residual_norm, attempts, leaps, iterations, .. } => format!(
+            "stopped after modal amplitude {:.4e} m·√kg: {attempts} steps failed, ever smaller down to the minimum step, then {leaps} leaps ever longer ({iterations} Newton iterations, last residual {residual_norm:.3e}); the last was rejected because {rejection}; try more [harmonic_balance] samples, or negative_damping = \"target_mode\" where other modes lie near a harmonic of this one",
+            amplitude(lambda)
+        ),
+        TerminationReason::ProblemError { lambda, error, .. } => {
+            format!("the harmonic balance failed at modal amplitude {:.4e} m·√kg: {error}", amplitude(lambda))
+        }
+    }
 }
 
 /// [`describe_termination`], with what was found where a branch stopped short in place of the

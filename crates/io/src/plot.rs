@@ -22,7 +22,9 @@ use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use rayon::prelude::*;
 
-use crate::output::{ElementRecord, JointSides, LevelResult, OutputError, PointRecord, SnapshotResult};
+use crate::output::{
+    BifurcationRecord, ElementRecord, JointSides, LevelResult, OutputError, PointRecord, SnapshotResult,
+};
 use crate::records::{FrfSet, TimeRecords};
 use crate::study::PlotFormat;
 
@@ -316,11 +318,13 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
             }
         }
     }
-    let any_unstable = curves.iter().any(|c| c.dashed.iter().any(|&u| u));
     Chart {
         title: format!(
             "FRF of {output} (displacement |X₁|/F, one curve per level{})",
-            if any_unstable { "; dashed: unstable" } else { "" }
+            match dashed_note(&curves) {
+                "" => String::new(),
+                note => format!("; {note}"),
+            }
         ),
         x_label: "Frequency (Hz)".into(),
         y_label: "Displacement / force (m/N)".into(),
@@ -334,6 +338,29 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
 /// Is this point known to be unstable?
 fn is_unstable(p: &PointRecord) -> bool {
     p.stability.is_some_and(|s| !s.stable)
+}
+
+/// `"dashed: unstable"` when a curve has an unstable stretch, else empty: the titles of the
+/// FRF, phase and harmonics plots say what the dashes mean.
+fn dashed_note(curves: &[Curve]) -> &'static str {
+    if curves.iter().any(|c| c.dashed.iter().any(|&u| u)) {
+        "dashed: unstable"
+    } else {
+        ""
+    }
+}
+
+/// The phase of a harmonic `(A_k, φ_k)` as the phase plot draws it: φ_k in degrees, wrapped
+/// as [`crate::output::harmonics_from_coefficients`] gives it, in (−180, 180]. The curves' points and
+/// the bifurcations' markers both go through here, so that a marker sits on its curve.
+fn phase_degrees(h: (f64, f64)) -> f64 {
+    h.1.to_degrees()
+}
+
+/// The harmonics `(A_k, φ_k)`, k = 0..=N, of `output` at bifurcation `b` (empty when the record
+/// does not carry them).
+fn bifurcation_harmonics<'b>(b: &'b BifurcationRecord, output: &str) -> &'b [(f64, f64)] {
+    b.harmonics.iter().find(|(name, _)| name == output).map_or(&[], |(_, h)| h.as_slice())
 }
 
 /// The short mark of a bifurcation kind on plots (its name in full is in bifurcations.csv).
@@ -412,20 +439,39 @@ fn per_output<'a>(
         .collect()
 }
 
-/// Amplitudes of harmonics 1..N (m, log scale) of `output` against frequency (Hz) for one level.
+/// Amplitudes of harmonics 1..N (m, log scale) of `output` against frequency (Hz) for one level;
+/// dashed where the response is unstable, and the level's bifurcations marked on every
+/// harmonic that is not zero there.
 pub fn plot_harmonics(path: &Path, level: &LevelResult, output: &str) -> Result<(), OutputError> {
     let Some(p0) = level.points.first() else {
         return Err(OutputError::Plot(format!("level {} N has no points to plot", level.level_n)));
     };
     let o = output_index(p0, output)?;
     let curves = harmonic_curves(level, o);
+    // Each bifurcation on every harmonic's curve; the chart leaves out the markers of a
+    // harmonic that is zero (or round-off) there, as it does the curves' points.
+    let markers = level
+        .bifurcations
+        .iter()
+        .flat_map(|b| {
+            let h = bifurcation_harmonics(b, output);
+            (1..h.len().min(curves.len() + 1)).map(move |k| Marker {
+                x: b.frequency_hz,
+                y: h[k].0,
+                label: bifurcation_symbol(&b.kind).into(),
+            })
+        })
+        .collect();
     Chart {
-        title: format!("Harmonics of {output} at {} N", level.level_n),
+        title: match dashed_note(&curves) {
+            "" => format!("Harmonics of {output} at {} N", level.level_n),
+            note => format!("Harmonics of {output} at {} N ({note})", level.level_n),
+        },
         x_label: "Frequency (Hz)".into(),
         y_label: "Amplitude (m)".into(),
         log_y: true,
         curves,
-        markers: Vec::new(),
+        markers,
     }
     .render(path)
 }
@@ -566,16 +612,18 @@ fn level_details<'a>(dir: &Path, levels: &'a [LevelResult], format: PlotFormat) 
 
 /// Phase of the first harmonic of `output` against the force, in degrees in (−180, 180],
 /// against frequency (Hz), one curve per level: with `x = A₁ cos(Ωt + φ₁)` under
-/// `F cos Ωt`, φ₁ (0 well below a resonance, −90° at it, −180° above).
+/// `F cos Ωt`, φ₁ (0 well below a resonance, −90° at it, −180° above); dashed where the
+/// response is unstable and the bifurcations marked, as [`plot_frf`].
 pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Result<(), OutputError> {
     let mut curves = Vec::with_capacity(levels.len());
+    let mut markers = Vec::new();
     for l in levels {
         let points = match l.points.first() {
             Some(p0) => {
                 let o = output_index(p0, output)?;
                 l.points
                     .iter()
-                    .filter_map(|p| p.outputs[o].harmonics.get(1).map(|h| (p.frequency_hz, h.1.to_degrees())))
+                    .filter_map(|p| p.outputs[o].harmonics.get(1).map(|&h| (p.frequency_hz, phase_degrees(h))))
                     .collect()
             }
             None => Vec::new(),
@@ -585,14 +633,29 @@ pub fn plot_frf_phase(path: &Path, levels: &[LevelResult], output: &str) -> Resu
             points,
             dashed: l.points.iter().map(is_unstable).collect(),
         });
+        for b in &l.bifurcations {
+            if let Some(&h) = bifurcation_harmonics(b, output).get(1) {
+                markers.push(Marker {
+                    x: b.frequency_hz,
+                    y: phase_degrees(h),
+                    label: bifurcation_symbol(&b.kind).into(),
+                });
+            }
+        }
     }
     Chart {
-        title: format!("Phase of {output} (harmonic 1 against the force, one curve per level)"),
+        title: format!(
+            "Phase of {output} (harmonic 1 against the force, one curve per level{})",
+            match dashed_note(&curves) {
+                "" => String::new(),
+                note => format!("; {note}"),
+            }
+        ),
         x_label: "Frequency (Hz)".into(),
         y_label: "Phase (degrees)".into(),
         log_y: false,
         curves,
-        markers: Vec::new(),
+        markers,
     }
     .render(path)
 }
@@ -1027,6 +1090,149 @@ mod tests {
             LevelResult { level_n: 10.0, points: vec![point(100.0, 1e-5), point(101.0, 0.0)], ..Default::default() };
         let labels: Vec<String> = super::harmonic_curves(&level, 0).into_iter().map(|c| c.label).collect();
         assert_eq!(labels, ["harmonic 1", "harmonic 2 (zero)", "harmonic 3"]);
+    }
+
+    /// The centres of an SVG plot's circles (pixels).
+    fn circle_centres(svg: &str) -> Vec<(i64, i64)> {
+        let attribute = |element: &str, name: &str| -> i64 {
+            let at = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+            element[at..].split('"').next().unwrap().parse().unwrap()
+        };
+        svg.split("<circle").skip(1).map(|c| (attribute(c, "cx"), attribute(c, "cy"))).collect()
+    }
+
+    /// The curves' polylines (2 px wide) of an SVG plot: their colour and vertices (pixels), in
+    /// the order drawn.
+    fn curve_polylines(svg: &str) -> Vec<(String, Vec<(i64, i64)>)> {
+        let attribute = |element: &str, name: &str| -> String {
+            let at = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+            element[at..].split('"').next().unwrap().to_string()
+        };
+        svg.split("<polyline")
+            .skip(1)
+            .filter(|l| attribute(l, "stroke-width") == "2")
+            .map(|l| {
+                let vertices = attribute(l, "points")
+                    .split_whitespace()
+                    .map(|p| {
+                        let (x, y) = p.split_once(',').unwrap();
+                        (x.parse().unwrap(), y.parse().unwrap())
+                    })
+                    .collect();
+                (attribute(l, "stroke"), vertices)
+            })
+            .collect()
+    }
+
+    /// The colour of the curve that has each circle's centre as a vertex (a marker on its
+    /// curve, at one of its points); panics when a circle is on no curve or on two.
+    fn curves_marked(svg: &str) -> Vec<String> {
+        let lines = curve_polylines(svg);
+        circle_centres(svg)
+            .into_iter()
+            .map(|c| {
+                let mut on = lines.iter().filter(|l| l.1.contains(&c)).map(|l| l.0.clone()).collect::<Vec<_>>();
+                on.dedup();
+                assert_eq!(on.len(), 1, "marker at {c:?} on curves {on:?}");
+                on.remove(0)
+            })
+            .collect()
+    }
+
+    /// How many text elements of an SVG plot read `label`.
+    fn labels(svg: &str, label: &str) -> usize {
+        svg.split('>').filter_map(|t| t.split('<').next()).filter(|t| t.trim() == label).count()
+    }
+
+    /// A level over 100..110 Hz whose harmonics come from Fourier coefficients as a sweep's do:
+    /// harmonic 1 of amplitude `scale` (1 + i) and phase −`rate` i rad (−0.65 i wraps past −π at
+    /// 105 Hz); harmonic 2 exactly zero (a half-wave symmetric response); harmonic 3 smaller.
+    /// With `fold`, a fold at 105 Hz recorded as the sweep records it, and the points after
+    /// 106 Hz unstable.
+    fn folded_level(level_n: f64, scale: f64, rate: f64, fold: bool) -> crate::output::LevelResult {
+        use crate::output::{
+            harmonics_from_coefficients, BifurcationRecord, LevelResult, OutputRecord, PointRecord, PointStability,
+        };
+        let coefficients = |i: usize| {
+            let (a1, p1) = (scale * (1.0 + i as f64), -rate * i as f64);
+            let (a3, p3) = (1e-2 * a1, 0.4 * i as f64);
+            vec![0.0, a1 * p1.cos(), -a1 * p1.sin(), 0.0, 0.0, a3 * p3.cos(), -a3 * p3.sin()]
+        };
+        let points = (0..=10)
+            .map(|i| {
+                let harmonics = harmonics_from_coefficients(&coefficients(i));
+                PointRecord {
+                    frequency_hz: 100.0 + i as f64,
+                    outputs: vec![OutputRecord {
+                        name: "mass".into(),
+                        disp_frf: harmonics[1].0 / level_n,
+                        harmonics,
+                        ..OutputRecord::default()
+                    }],
+                    stability: fold.then_some(PointStability {
+                        stable: i <= 6,
+                        exponent_re: if i <= 6 { -1.0 } else { 1.0 },
+                        exponent_im: 0.0,
+                    }),
+                    ..PointRecord::default()
+                }
+            })
+            .collect();
+        let bifurcations = if fold {
+            let harmonics = harmonics_from_coefficients(&coefficients(5));
+            vec![BifurcationRecord {
+                level_n,
+                kind: "fold".into(),
+                frequency_hz: 105.0,
+                amplitudes: vec![("mass".into(), harmonics[1].0)],
+                harmonics: vec![("mass".into(), harmonics)],
+                exponent_im: 0.0,
+                located: true,
+            }]
+        } else {
+            Vec::new()
+        };
+        LevelResult { level_n, points, bifurcations, ..Default::default() }
+    }
+
+    /// The fold of a level is marked on its phase curve (at the phase the curve has there, past
+    /// the wrap at −180°) and on harmonics 1 and 3 of its harmonics plot (not on harmonic 2,
+    /// zero); a level without bifurcations carries no marker. Titles say what dashes mean.
+    #[test]
+    fn phase_and_harmonics_plots_mark_the_bifurcations_on_their_curves() {
+        let dir = std::env::temp_dir().join(format!("stickslip-plot-marked-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (folded, plain) = (folded_level(10.0, 1e-4, 0.65, true), folded_level(20.0, 3e-4, 0.3, false));
+        let labels = |svg: &str| labels(svg, "LP");
+        let read = |path: &std::path::Path| std::fs::read_to_string(path).unwrap();
+
+        let both = dir.join("phase_both.svg");
+        super::plot_frf_phase(&both, &[folded.clone(), plain.clone()], "mass").unwrap();
+        let svg = read(&both);
+        assert_eq!(labels(&svg), 1, "one fold, one label");
+        // On the folded level's curve (the first drawn), at its point of 105 Hz: past the wrap,
+        // near +180°, as the curve has it.
+        assert_eq!(curves_marked(&svg), [curve_polylines(&svg)[0].0.clone()]);
+        assert!(svg.contains("one curve per level; dashed: unstable"), "the title says what dashes mean");
+
+        let harmonics = dir.join("harmonics_folded.svg");
+        super::plot_harmonics(&harmonics, &folded, "mass").unwrap();
+        let svg = read(&harmonics);
+        assert_eq!(labels(&svg), 2, "marked on harmonics 1 and 3");
+        let marked = curves_marked(&svg);
+        assert_eq!(marked.len(), 2);
+        assert_ne!(marked[0], marked[1], "on two curves");
+        assert!(svg.contains("Harmonics of mass at 10 N (dashed: unstable)"));
+
+        let (phase, harmonics) = (dir.join("phase_plain.svg"), dir.join("harmonics_plain.svg"));
+        super::plot_frf_phase(&phase, std::slice::from_ref(&plain), "mass").unwrap();
+        super::plot_harmonics(&harmonics, &plain, "mass").unwrap();
+        for path in [phase, harmonics] {
+            let (svg, name) = (read(&path), path.display());
+            assert_eq!((labels(&svg), circle_centres(&svg).len()), (0, 0), "{name}: no bifurcation, no marker");
+            assert!(!svg.contains("dashed"), "{name}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -582,8 +582,8 @@ fn bifurcation_section(h: &mut String, data: &ReportData) {
         let _ = writeln!(
             h,
             "<p>Each point's stability comes from its Floquet exponents by Hill's method (frf.csv: <code>stable</code>, \
-             <code>floquet_re_per_s</code>, <code>floquet_im_rad_per_s</code>); unstable branches are dashed in the FRF \
-             plots. {singular}; period doublings (PD) and Neimark-Sacker bifurcations (NS) from a complex pair of \
+             <code>floquet_re_per_s</code>, <code>floquet_im_rad_per_s</code>); unstable branches are dashed in the FRF, \
+             phase and harmonics plots, which mark the bifurcations. {singular}; period doublings (PD) and Neimark-Sacker bifurcations (NS) from a complex pair of \
              exponents crossing the imaginary axis (<code>bifurcations.csv</code>).</p>"
         );
     } else {
@@ -887,6 +887,7 @@ mod tests {
             kind: "fold".into(),
             frequency_hz: 241.25,
             amplitudes: vec![("mass".into(), 2.5e-4)],
+            harmonics: vec![("mass".into(), vec![(0.0, 0.0), (2.5e-4, -1.2)])],
             exponent_im: 0.0,
             located: true,
         };

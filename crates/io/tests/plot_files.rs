@@ -273,13 +273,15 @@ fn unstable_stretches_are_drawn_dashed_and_bifurcations_marked() {
         p.stability = Some(PointStability { stable, exponent_re: if stable { -1.0 } else { 1.0 }, exponent_im: 0.0 });
     }
     for f in [240.0, 260.0] {
-        // On the curve: |X₁| = (|X₁|/F) × F.
-        let on_curve = levels[1].points.iter().find(|p| p.frequency_hz == f).unwrap().outputs[0].disp_frf * 1000.0;
+        // On the curve: |X₁| = (|X₁|/F) × F, and the point's harmonics.
+        let point = &levels[1].points.iter().find(|p| p.frequency_hz == f).unwrap().outputs[0];
+        let (on_curve, harmonics) = (point.disp_frf * 1000.0, point.harmonics.clone());
         levels[1].bifurcations.push(BifurcationRecord {
             level_n: 1000.0,
             kind: "fold".into(),
             frequency_hz: f,
             amplitudes: vec![("mass".into(), on_curve)],
+            harmonics: vec![("mass".into(), harmonics)],
             exponent_im: 0.0,
             located: true,
         });
@@ -293,11 +295,13 @@ fn unstable_stretches_are_drawn_dashed_and_bifurcations_marked() {
         let wide = text.matches("stroke-width=\"2\"").count();
         assert!(wide > 3 + 3 + 5, "{}: {wide} lines 2 px wide, no dashes", path.display());
     }
-    let text = svg(&amplitude[0]);
-    assert!(text.contains("dashed: unstable"), "the title says what dashes mean");
-    // A marker is a ring of radius 5 with its kind's symbol beside it.
-    assert_eq!(text.matches("<circle").count(), 2, "the two folds marked");
-    assert!(text.contains("r=\"5\"") && text.contains("LP"), "the folds' rings and symbol");
+    for path in [&amplitude[0], &phase[0]] {
+        let text = svg(path);
+        assert!(text.contains("dashed: unstable"), "{}: the title says what dashes mean", path.display());
+        // A marker is a ring of radius 5 with its kind's symbol beside it.
+        assert_eq!(text.matches("<circle").count(), 2, "{}: the two folds marked", path.display());
+        assert!(text.contains("r=\"5\"") && text.contains("LP"), "{}: the folds' rings and symbol", path.display());
+    }
     // Without stability, the same curves are solid.
     let stable = scratch_dir("plot-stable");
     let text = svg(&plot_frfs(&stable, &self::levels(), PlotFormat::Svg).unwrap()[0]);

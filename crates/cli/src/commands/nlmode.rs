@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::Context;
 use stickslip_core::continuation::Point;
 use stickslip_core::model::NonlinearModel;
-use stickslip_io::analysis::{describe_termination, run_nonlinear_mode};
+use stickslip_io::analysis::{describe_backbone_termination, run_nonlinear_mode};
 use stickslip_io::backbone::{single_mode_frfs, write_backbone_csv, write_single_mode_csv};
 use stickslip_io::output::LevelResult;
 use stickslip_io::study::{OutputSpec, PlotFormat, Study};
@@ -103,10 +103,7 @@ pub fn compute_and_write(
             last.frequency_hz(),
             first.damping_ratio(),
             last.damping_ratio(),
-            match backbone.termination {
-                stickslip_core::continuation::TerminationReason::ReachedEnd => "reached the last amplitude".to_string(),
-                ref t => describe_termination(t),
-            },
+            describe_backbone_termination(&backbone.termination),
             started.elapsed().as_secs_f64(),
             if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
         );
@@ -114,7 +111,7 @@ pub fn compute_and_write(
     if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
         anyhow::bail!(
             "nonlinear mode: the branch {} (its points are written)",
-            describe_termination(&backbone.termination)
+            describe_backbone_termination(&backbone.termination)
         );
     }
     Ok(files)
