@@ -15,13 +15,12 @@ fn main() {
     let runs = if quick { 3 } else { 11 };
     faer::set_global_parallelism(faer::Par::Seq);
     println!("stickslip nonlinear mode benchmark: N = 7, 300 samples, one thread, median of {runs} runs");
+    let mass = std::env::args().any(|a| a == "mass");
+    let negative_damping = if mass { NegativeDamping::MassProportional } else { NegativeDamping::TargetMode };
     for n in [137, 149] {
         let model = chain_with_joints(n, 4, false);
-        let settings = NonlinearModeSettings {
-            mode: 0,
-            hbm: HbmSettings { harmonics: 7, samples: 300 },
-            negative_damping: NegativeDamping::TargetMode,
-        };
+        let settings =
+            NonlinearModeSettings { mode: 0, hbm: HbmSettings { harmonics: 7, samples: 300 }, negative_damping };
         // Four decades, from the stuck mode to joints slipping over most of the cycle. The
         // negative damping acts on the target mode only: with D = αM, −ξM would leave the 136
         // other modes undamped, some near a harmonic of the mode (see NegativeDamping).

@@ -32,10 +32,17 @@
 //! paper's form (Eq. 11) return forces net of the stiffness they replace in K, so a stuck joint
 //! gives `G = 0` and the linear mode solves the balance exactly.
 //!
-//! The phase is fixed by `η_s1 = 0` and the amplitude by `η_c1 = a` (Krack 2015, Eqs. 3-4, with
-//! the modal coordinate in place of the mass norm of the whole harmonic 1): both enter as
-//! fixed values, not unknowns. The continuation parameter is `λ = log10 a`, so a branch spans
-//! decades of amplitude with steps of even relative size.
+//! The phase is fixed by `η_s1 = 0` (a fixed value, not an unknown) and the amplitude by the
+//! mass norm of harmonic 1 of the whole motion (Krack 2015, Eqs. 3-4):
+//!
+//! ```text
+//! R_a = X_1ᴴ M X_1 / a² − 1 = |η_1|² / a² + Σ_{r≠*} |p_r1|² / a² − 1,    p_r1 = −a_rᵀ G_1 / den_r(Ω; ξ)
+//! ```
+//!
+//! so that `a` measures the motion, not only the target mode's share of it, which falls where
+//! slipping joints move the other modes (on a model with many modes it can even fall while the
+//! motion grows). The continuation parameter is `λ = log10 a`, so a branch spans decades of
+//! amplitude with steps of even relative size.
 //!
 //! # Scaled unknowns
 //!
@@ -43,8 +50,8 @@
 //! residual is of order one from the linear regime (a → 0) to full slip:
 //!
 //! ```text
-//! y = [u/a (q(2N+1)),  η/a without c1, s1 (2N−1),  w = Ω/ω_*,  ξ̂ = ξ/ω_*]
-//! R = [R_u / a,  R_η / (a ω_*²)]
+//! y = [u/a (q(2N+1)),  η/a without s1 (2N),  w = Ω/ω_*,  ξ̂ = ξ/ω_*]
+//! R = [R_u / a,  R_η / (a ω_*²),  R_a]
 //! ```
 //!
 //! The Jacobian is analytic; the λ-derivative follows from `d(G(a û)/a)/dλ = ln 10 (∂G/∂u û −
@@ -119,6 +126,13 @@ pub struct NonlinearMode<'m> {
     dh_dxi: Vec<Mat<c64>>,
     /// `∂G/∂u û − G/a` (the amplitude derivative of the scaled forces, over ln 10).
     t: Vec<f64>,
+    /// The condensed modes' share of the amplitude: `N = Σ_{r≠*} a_r a_rᵀ / |den_r(Ω; ξ)|²`
+    /// (q × q) and its derivatives in Ω and ξ (see [`NonlinearMode::amplitude_weights`]).
+    n_w: Mat<f64>,
+    dn_domega: Mat<f64>,
+    dn_dxi: Mat<f64>,
+    /// `N Ĝ_c1` then `N Ĝ_s1` (2q), with `Ĝ = G/a`.
+    ng: Vec<f64>,
     /// Residual and Jacobian evaluations since creation.
     pub evaluations: usize,
 }
@@ -168,6 +182,9 @@ pub struct BackbonePoint {
     pub stick_fraction: Vec<f64>,
     /// Coefficient vectors `[c0, c1, s1, ...]` (m) of each requested output.
     pub outputs: Vec<Vec<f64>>,
+    /// Harmonic 1 of every modal coordinate, `p_r1 = c − i s` (m·√kg, the modes of
+    /// [`Backbone::shapes`]): `Σ_r |p_r1|² = a²`, the amplitude condition.
+    pub modal_harmonic1: Vec<c64>,
     /// The scaled unknowns of the balance (see the module documentation).
     pub y: Vec<f64>,
 }
@@ -203,11 +220,11 @@ pub struct Backbone {
     pub notes: Vec<String>,
     /// The raw continuation branch (call counts, residuals); `None` without joints.
     pub branch: Option<Branch>,
-    /// The target mode's viscous modal coefficient `c_*` (1/s) and its mass-normalised shape
-    /// (n): what the forced response synthesised from the backbone needs
-    /// ([`Backbone::single_mode_response`]).
+    /// The target mode's viscous modal coefficient `c_*` (1/s) and the model's mass-normalised
+    /// modes (n × m, those of [`BackbonePoint::modal_harmonic1`]): what the forced response
+    /// synthesised from the backbone needs ([`Backbone::single_mode_response`]).
     pub viscous: f64,
-    pub shape: Vec<f64>,
+    pub shapes: Mat<f64>,
 }
 
 /// One point of a forced response synthesised from a backbone.
@@ -225,7 +242,7 @@ impl Backbone {
     /// assumed to move in the nonlinear mode, whose amplitude `a` answers the force as
     ///
     /// ```text
-    /// [ω(a)² − Ω² + i (Ω c_* + ω(a) (ξ(a) − c_*))] a = φᵀF e^{iψ}
+    /// [ω(a)² − Ω² + i (Ω c_* + ω(a) (ξ(a) − c_*))] a = ψ_1ᴴF e^{iψ},   ψ_1 = X_1 / a
     /// ```
     ///
     /// with the viscous damping `c_*` acting at the forcing frequency and the joints' part
@@ -236,10 +253,15 @@ impl Backbone {
     /// Returned in frequency order along the curve: the lower side by rising amplitude, then
     /// the upper side by falling amplitude.
     pub fn single_mode_response(&self, load: &[f64], level: f64) -> Vec<SynthesisedPoint> {
-        let force = level * self.shape.iter().zip(load).map(|(p, f)| p * f).sum::<f64>();
+        // `b_r = φ_rᵀ F`; the mode's force at a point is `|ψ_1ᴴ F|` with `ψ_1 = X_1 / a` its
+        // harmonic-1 shape, mass-normalised (`ψ_1ᴴ M ψ_1 = 1`): `Σ_r conj(p_r1) b_r / a`.
+        let (n, m) = (self.shapes.nrows(), self.shapes.ncols());
+        let b: Vec<f64> = (0..m).map(|r| (0..n).map(|l| self.shapes[(l, r)] * load[l]).sum()).collect();
         let c = self.viscous;
         let (mut lower, mut upper) = (Vec::new(), Vec::new());
         for (i, p) in self.points.iter().enumerate() {
+            let force = level * p.modal_harmonic1.iter().zip(&b).map(|(pr, br)| pr.conj() * br).sum::<c64>().norm()
+                / p.amplitude;
             let (w, beta) = (p.omega, p.omega * (p.xi - c));
             let f = |o: f64| (w * w - o * o).powi(2) + (o * c + beta).powi(2) - (force / p.amplitude).powi(2);
             if f(w) >= 0.0 || f(w).is_nan() {
@@ -307,6 +329,10 @@ impl<'m> NonlinearMode<'m> {
             dh_domega: zeros(),
             dh_dxi: zeros(),
             t: vec![0.0; q * nc],
+            n_w: Mat::zeros(q, q),
+            dn_domega: Mat::zeros(q, q),
+            dn_dxi: Mat::zeros(q, q),
+            ng: vec![0.0; 2 * q],
             plan,
             evaluations: 0,
         })
@@ -336,23 +362,54 @@ impl<'m> NonlinearMode<'m> {
         self.dimension() - 2
     }
 
-    /// `η_c / a` for coefficient c: the fixed amplitude and phase (1, 0) for c1 and s1.
+    /// `η_c / a` for coefficient c: the phase condition fixes s1 at 0.
     fn eta(&self, y: &[f64], c: usize) -> f64 {
-        match c {
-            1 => 1.0,
-            2 => 0.0,
-            0 => y[self.q * self.plan.n_coeffs()],
-            _ => y[self.q * self.plan.n_coeffs() + c - 2],
-        }
+        self.eta_column(c).map_or(0.0, |col| y[col])
     }
 
-    /// Column of the unknown `η_c / a` (`None` for the fixed c1, s1).
+    /// Column of the unknown `η_c / a` (`None` for the fixed s1).
     fn eta_column(&self, c: usize) -> Option<usize> {
         let base = self.q * self.plan.n_coeffs();
         match c {
-            1 | 2 => None,
-            0 => Some(base),
-            _ => Some(base + c - 2),
+            2 => None,
+            0 | 1 => Some(base + c),
+            _ => Some(base + c - 1),
+        }
+    }
+
+    /// The condensed modes' part of the amplitude condition. Their harmonic 1 is
+    /// `p_r1 = −a_rᵀ G_1 / den_r(Ω)`, so `Σ_{r≠*} |p_r1|² = G_1ᴴ N G_1` with the real symmetric
+    ///
+    /// ```text
+    /// N(Ω, ξ) = Σ_{r≠*} a_r a_rᵀ / |den_r|²,   |den_r|² = (ω_r² − Ω²)² + Ω² (c_r − ξ_r)²
+    /// ```
+    ///
+    /// (`ξ_r = ξ` with [`NegativeDamping::MassProportional`], 0 otherwise); `n_w`, `dn_domega`
+    /// and `dn_dxi` receive N, ∂N/∂Ω and ∂N/∂ξ.
+    fn amplitude_weights(&mut self, omega: f64, xi: f64) {
+        let q = self.q;
+        let (omega_r, c_r) = (self.linear.natural_frequencies(), self.linear.damping_coefficients());
+        let a = self.linear.participation();
+        let shift = if self.shift_all { xi } else { 0.0 };
+        self.n_w.fill(0.0);
+        self.dn_domega.fill(0.0);
+        self.dn_dxi.fill(0.0);
+        let o2 = omega * omega;
+        for r in (0..omega_r.len()).filter(|&r| r != self.target) {
+            let (s, c) = (omega_r[r] * omega_r[r] - o2, c_r[r] - shift);
+            let den2 = s * s + o2 * c * c;
+            let inv = 1.0 / den2;
+            // ∂(1/|den|²) = −∂|den|² / |den|⁴.
+            let d_omega = -(-4.0 * omega * s + 2.0 * omega * c * c) * inv * inv;
+            let d_xi = if self.shift_all { 2.0 * o2 * c * inv * inv } else { 0.0 };
+            for j in 0..q {
+                for i in 0..q {
+                    let aa = a[(i, r)] * a[(j, r)];
+                    self.n_w[(i, j)] += aa * inv;
+                    self.dn_domega[(i, j)] += aa * d_omega;
+                    self.dn_dxi[(i, j)] += aa * d_xi;
+                }
+            }
         }
     }
 
@@ -363,6 +420,7 @@ impl<'m> NonlinearMode<'m> {
         for i in 0..self.q {
             y[cos_index(1) * self.q + i] = self.a_t[i];
         }
+        y[self.eta_column(cos_index(1)).expect("c1 is an unknown")] = 1.0;
         let iw = self.i_omega();
         y[iw] = 1.0;
         y[iw + 1] = self.c_t / self.omega_t;
@@ -511,6 +569,7 @@ impl<'m> NonlinearMode<'m> {
             joint_energy,
             stick_fraction,
             outputs,
+            modal_harmonic1: modal.iter().map(|p| p[1]).collect(),
             y: y.to_vec(),
         })
     }
@@ -518,7 +577,7 @@ impl<'m> NonlinearMode<'m> {
 
 impl Problem for NonlinearMode<'_> {
     fn dimension(&self) -> usize {
-        (self.q + 1) * self.plan.n_coeffs()
+        (self.q + 1) * self.plan.n_coeffs() + 1
     }
 
     fn evaluate(
@@ -541,6 +600,7 @@ impl Problem for NonlinearMode<'_> {
         let want = jacobian.is_some();
         self.element_forces(y, amplitude, omega, want).map_err(|e| ProblemError::at_trial_iterate(e.to_string()))?;
         self.receptances(omega, xi);
+        self.amplitude_weights(omega, xi);
         let inv_a = 1.0 / amplitude;
         let base = q * nc;
         // R_u (scaled by 1/a): û − a_* η̂ + H_rest G/a.
@@ -582,6 +642,27 @@ impl Problem for NonlinearMode<'_> {
             residual[base + ic] = zr * ec + zi * es + proj(&self.joints.g, ic) * inv_a / w2;
             residual[base + is] = -zi * ec + zr * es + proj(&self.joints.g, is) * inv_a / w2;
         }
+        // R_a = |η̂_1|² + Ĝ_1ᴴ N Ĝ_1 − 1: the mass norm of harmonic 1 of the whole motion,
+        // `X_1ᴴ M X_1 = Σ_r |p_r1|²` in mass-normalised modes, is a² (Krack 2015, Eq. 4).
+        let (c1, s1) = (cos_index(1), sin_index(1));
+        let row_a = base + nc;
+        let g_hat = |g: &[f64], part: usize, j: usize| g[part * q + j] * inv_a;
+        for i in 0..q {
+            self.ng[i] = (0..q).map(|j| self.n_w[(i, j)] * g_hat(&self.joints.g, c1, j)).sum();
+            self.ng[q + i] = (0..q).map(|j| self.n_w[(i, j)] * g_hat(&self.joints.g, s1, j)).sum();
+        }
+        let quadratic = |n: &Mat<f64>, g: &[f64]| -> f64 {
+            [c1, s1]
+                .iter()
+                .map(|&part| {
+                    (0..q)
+                        .map(|i| g_hat(g, part, i) * (0..q).map(|j| n[(i, j)] * g_hat(g, part, j)).sum::<f64>())
+                        .sum::<f64>()
+                })
+                .sum()
+        };
+        let e1 = self.eta(y, c1);
+        residual[row_a] = e1 * e1 + quadratic(&self.n_w, &self.joints.g) - 1.0;
         let Some((mut dy, dl)) = jacobian else { return Ok(()) };
 
         // ∂/∂û: I + H_rest ∂G/∂u on R_u, a_*ᵀ ∂G/∂u / ω_*² on R_η (∂(G(aû)/a)/∂û = ∂G/∂u).
@@ -609,6 +690,13 @@ impl Problem for NonlinearMode<'_> {
                         let v: f64 = (0..d).map(|a| self.a_t[off + a] * je[(c * d + a, ecol)]).sum();
                         dy[(base + c, col)] += v / w2;
                     }
+                    // R_a row: 2 (N Ĝ_1)ᴴ ∂G_1/∂u.
+                    let v: f64 = (0..d)
+                        .map(|a| {
+                            self.ng[off + a] * je[(c1 * d + a, ecol)] + self.ng[q + off + a] * je[(s1 * d + a, ecol)]
+                        })
+                        .sum();
+                    dy[(row_a, col)] += 2.0 * v;
                     // R_u rows, harmonic 0 then k ≥ 1.
                     for i in 0..q {
                         let v: f64 = (0..d).map(|a| self.h[0][(i, off + a)].re * je[(a, ecol)]).sum();
@@ -641,16 +729,20 @@ impl Problem for NonlinearMode<'_> {
             }
         }
         dy[(base, base)] = 1.0;
-        for k in 2..=nh {
+        for k in 1..=nh {
             let kw = k as f64 * w;
             let (zr, zi) = (1.0 - kw * kw, kw * (ct - xih));
             let (ic, is) = (cos_index(k), sin_index(k));
-            let (cc, cs) = (self.eta_column(ic).unwrap(), self.eta_column(is).unwrap());
-            dy[(base + ic, cc)] = zr;
-            dy[(base + ic, cs)] = zi;
-            dy[(base + is, cc)] = -zi;
-            dy[(base + is, cs)] = zr;
+            if let Some(cc) = self.eta_column(ic) {
+                dy[(base + ic, cc)] = zr;
+                dy[(base + is, cc)] = -zi;
+            }
+            if let Some(cs) = self.eta_column(is) {
+                dy[(base + ic, cs)] = zi;
+                dy[(base + is, cs)] = zr;
+            }
         }
+        dy[(row_a, self.eta_column(c1).expect("c1 is an unknown"))] = 2.0 * e1;
         // ∂/∂w = ω_* ∂/∂Ω and ∂/∂ξ̂ = ω_* ∂/∂ξ.
         let wt = self.omega_t;
         for k in 0..=nh {
@@ -718,6 +810,14 @@ impl Problem for NonlinearMode<'_> {
         for c in 0..nc {
             dl[base + c] = LN_10 * proj(&self.t, c) / w2;
         }
+        // R_a in w, ξ̂ and λ: ∂Ĝ/∂Ω = ∂G/∂Ω / a, ∂Ĝ/∂λ = ln 10 t.
+        let cross = |g: &[f64], scale: f64| -> f64 {
+            (0..q).map(|i| self.ng[i] * g[c1 * q + i] + self.ng[q + i] * g[s1 * q + i]).sum::<f64>() * scale
+        };
+        dy[(row_a, iw)] +=
+            wt * (2.0 * cross(&self.joints.dg_domega, inv_a) + quadratic(&self.dn_domega, &self.joints.g));
+        dy[(row_a, iw + 1)] += wt * quadratic(&self.dn_dxi, &self.joints.g);
+        dl[row_a] = 2.0 * LN_10 * cross(&self.t, 1.0);
         Ok(())
     }
 
@@ -791,7 +891,7 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
         notes: Vec::new(),
         branch: Some(branch),
         viscous: problem.c_t,
-        shape: problem.linear.modes().shapes.col(settings.mode).iter().copied().collect(),
+        shapes: problem.linear.modes().shapes.clone(),
     })
 }
 
@@ -834,6 +934,7 @@ fn linear_backbone(
                     v
                 })
                 .collect(),
+            modal_harmonic1: (0..modes.omega.len()).map(|s| c64::new(if s == r { a } else { 0.0 }, 0.0)).collect(),
             y: Vec::new(),
         })
         .collect();
@@ -851,6 +952,6 @@ fn linear_backbone(
         )],
         branch: None,
         viscous: c,
-        shape: modes.shapes.col(r).iter().copied().collect(),
+        shapes: modes.shapes.clone(),
     })
 }
