@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use stickslip_core::continuation::SingularKind;
 use stickslip_core::hbm::Backbone;
 
 use crate::output::OutputError;
@@ -75,6 +76,42 @@ pub fn write_backbone_csv(
         text.push('\n');
     }
     std::fs::write(path, text).map_err(|source| OutputError::Io { path: path.to_path_buf(), source })
+}
+
+/// Write `backbone_bifurcations.csv` at `path`: one row per fold in amplitude or branch point
+/// of the backbone (`kind`, `modal_amplitude_m_sqrtkg`, `frequency_Hz`, `damping_ratio`,
+/// `located`), the header alone when there is none.
+pub fn write_backbone_singular_csv(path: &Path, backbone: &Backbone) -> Result<(), OutputError> {
+    let mut text = String::from("kind,modal_amplitude_m_sqrtkg,frequency_Hz,damping_ratio,located\n");
+    for s in &backbone.singular_points {
+        let values = [s.amplitude, s.omega / (2.0 * std::f64::consts::PI), s.damping_ratio()];
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(OutputError::NotFinite {
+                path: path.to_path_buf(),
+                quantity: "a backbone fold or branch point".into(),
+                location: format!("after backbone point {}", s.after_point + 1),
+                value: *v,
+            });
+        }
+        let _ = writeln!(
+            text,
+            "{},{:.10e},{:.10e},{:.10e},{}",
+            singular_kind_name(s.kind),
+            values[0],
+            values[1],
+            values[2],
+            s.located
+        );
+    }
+    std::fs::write(path, text).map_err(|source| OutputError::Io { path: path.to_path_buf(), source })
+}
+
+/// The name of a backbone's singular point in files and messages.
+pub fn singular_kind_name(kind: SingularKind) -> &'static str {
+    match kind {
+        SingularKind::Fold => "fold in amplitude",
+        SingularKind::BranchPoint => "branch point",
+    }
 }
 
 /// The forced response of one level synthesised from a backbone.

@@ -6,9 +6,12 @@ use std::time::Instant;
 
 use anyhow::Context;
 use stickslip_core::continuation::Point;
+use stickslip_core::hbm::Backbone;
 use stickslip_core::model::NonlinearModel;
 use stickslip_io::analysis::{describe_backbone_termination, run_nonlinear_mode};
-use stickslip_io::backbone::{single_mode_frfs, write_backbone_csv, write_single_mode_csv};
+use stickslip_io::backbone::{
+    single_mode_frfs, singular_kind_name, write_backbone_csv, write_backbone_singular_csv, write_single_mode_csv,
+};
 use stickslip_io::output::LevelResult;
 use stickslip_io::study::{OutputSpec, PlotFormat, Study};
 
@@ -73,7 +76,19 @@ pub fn compute_and_write(
     let joints: Vec<String> = model.elements.iter().map(|e| e.name.clone()).collect();
     let csv = out.join("backbone.csv");
     write_backbone_csv(&csv, &backbone, &joints, &names, study.hbm.harmonics)?;
-    let mut files = vec![csv];
+    let singular = out.join("backbone_bifurcations.csv");
+    write_backbone_singular_csv(&singular, &backbone)?;
+    let mut files = vec![csv, singular];
+    for s in &backbone.singular_points {
+        eprintln!(
+            "nonlinear mode: {} at modal amplitude {:.4e} m·√kg, {:.4} Hz, damping ratio {:.4e}{}",
+            singular_kind_name(s.kind),
+            s.amplitude,
+            s.omega / (2.0 * std::f64::consts::PI),
+            s.damping_ratio(),
+            if s.located { "" } else { " (not located: the point after it)" }
+        );
+    }
     if let Some(format) = plots {
         files.extend(stickslip_io::plot::plot_backbone(out, &backbone, format)?);
     }
@@ -103,16 +118,26 @@ pub fn compute_and_write(
             last.frequency_hz(),
             first.damping_ratio(),
             last.damping_ratio(),
-            describe_backbone_termination(&backbone.termination),
+            why_it_ended(&backbone),
             started.elapsed().as_secs_f64(),
             if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
         );
     }
     if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
-        anyhow::bail!(
-            "nonlinear mode: the branch {} (its points are written)",
-            describe_backbone_termination(&backbone.termination)
-        );
+        anyhow::bail!("nonlinear mode: the branch {} (its points are written)", why_it_ended(&backbone));
     }
     Ok(files)
+}
+
+/// Why the backbone ended, for users: where it turned back at a branch point, that point.
+fn why_it_ended(backbone: &Backbone) -> String {
+    match &backbone.turned_back_at {
+        Some(bp) => format!(
+            "turned back at a branch point at modal amplitude {:.4e} m·√kg, {:.4} Hz, damping ratio {:.4e} (another family of periodic motions crosses the backbone there; with alike joints, one where they stop moving alike) and the backbone is written up to it; the forced responses are the reference beyond",
+            bp.amplitude,
+            bp.omega / (2.0 * std::f64::consts::PI),
+            bp.damping_ratio()
+        ),
+        None => describe_backbone_termination(&backbone.termination),
+    }
 }

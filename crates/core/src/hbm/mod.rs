@@ -37,7 +37,8 @@ pub use element_aft::{AftError, ElementAft};
 pub use fourier::{AftPlan, AftScratch, FourierError};
 pub use full::FullHbm;
 pub use nonlinear_mode::{
-    nonlinear_mode, Backbone, BackbonePoint, NegativeDamping, NonlinearMode, NonlinearModeError, NonlinearModeSettings,
+    nonlinear_mode, Backbone, BackbonePoint, BackboneSingularPoint, NegativeDamping, NonlinearMode, NonlinearModeError,
+    NonlinearModeSettings,
 };
 pub use receptance::{HarmonicReceptance, LinearParameter, LinearVariation, ModalReceptance, Receptance};
 pub use stability::{Hill, HillSettings, Refined, Stability, StabilityError};

@@ -65,8 +65,8 @@ use super::fourier::{cos_index, sin_index, AftPlan, FourierError};
 use super::joint_forces::JointForces;
 use super::receptance::{LinearParameter, LinearVariation, ModalReceptance, Receptance};
 use crate::continuation::{
-    continue_branch, Branch, ContinuationError, Options, PointObserver, Problem, ProblemError, Scales,
-    TerminationReason,
+    continue_branch, singular_points, Accepted, Branch, ContinuationError, Options, PointObserver, Problem,
+    ProblemError, Scales, SingularKind, TerminationReason, TestFunctions,
 };
 use crate::model::{ModelError, NonlinearModel};
 
@@ -218,6 +218,12 @@ pub struct Backbone {
     pub termination: TerminationReason,
     /// Remarks for the user (e.g. a model without joints).
     pub notes: Vec<String>,
+    /// The folds in amplitude and the branch points met along the backbone, in branch order.
+    pub singular_points: Vec<BackboneSingularPoint>,
+    /// Where the continuation turned back along the backbone at a branch point and came back
+    /// to the first amplitude: the points after it, which only went back, are left out (the
+    /// raw `branch` keeps them).
+    pub turned_back_at: Option<BackboneSingularPoint>,
     /// The raw continuation branch (call counts, residuals); `None` without joints.
     pub branch: Option<Branch>,
     /// The target mode's viscous modal coefficient `c_*` (1/s) and the model's mass-normalised
@@ -225,6 +231,48 @@ pub struct Backbone {
     /// synthesised from the backbone needs ([`Backbone::single_mode_response`]).
     pub viscous: f64,
     pub shapes: Mat<f64>,
+}
+
+/// A fold in amplitude or a branch point of a backbone, located between two of its points
+/// from the continuation's test functions ([`singular_points`]): at a fold the amplitude turns
+/// back along the branch; at a branch point another family of periodic motions crosses it (on
+/// a structure with alike joints, one where the joints stop moving alike).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BackboneSingularPoint {
+    pub kind: SingularKind,
+    /// Modal amplitude a (m·√kg), Ω (rad/s) and ξ (1/s) there.
+    pub amplitude: f64,
+    pub omega: f64,
+    pub xi: f64,
+    /// Index of the backbone point just before it.
+    pub after_point: usize,
+    /// False when it could not be located between its two points (then it is the second).
+    pub located: bool,
+}
+
+impl BackboneSingularPoint {
+    /// Modal damping ratio ζ = ξ / (2Ω) there.
+    pub fn damping_ratio(&self) -> f64 {
+        self.xi / (2.0 * self.omega)
+    }
+}
+
+/// Precision of a located fold or branch point on the chord between its two points (scaled
+/// arclength), as the forced sweeps locate theirs.
+const SINGULAR_TOLERANCE: f64 = 1e-10;
+
+/// Hands every accepted point on to `inner`, keeping its test functions (from the
+/// corrector's last factorisation) for the backbone's folds and branch points.
+struct TestRecorder<'o, O: ?Sized> {
+    inner: &'o mut O,
+    tests: Vec<Option<TestFunctions>>,
+}
+
+impl<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized> PointObserver<NonlinearMode<'m>> for TestRecorder<'_, O> {
+    fn on_accepted(&mut self, accepted: &mut Accepted<'_, NonlinearMode<'m>>) {
+        self.tests.push(accepted.test_functions_estimate().ok().flatten().cloned());
+        self.inner.on_accepted(accepted);
+    }
 }
 
 /// One point of a forced response synthesised from a backbone.
@@ -854,7 +902,8 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
     let mut problem = NonlinearMode::new(model, settings)?;
     let guess = problem.linear_guess();
     let (l0, l1) = (amplitude_start.log10(), amplitude_end.log10());
-    let branch = continue_branch(&mut problem, &guess, l0, l1, options, observer)?;
+    let mut recorder = TestRecorder { inner: observer, tests: Vec::new() };
+    let branch = continue_branch(&mut problem, &guess, l0, l1, options, &mut recorder)?;
     if let TerminationReason::FirstPointFailed { .. } | TerminationReason::ProblemError { last_lambda: None, .. } =
         &branch.termination
     {
@@ -882,6 +931,34 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
     for p in &branch.points {
         points.push(problem.point(&p.x, p.lambda, outputs)?);
     }
+    let mut singular: Vec<BackboneSingularPoint> =
+        singular_points(&mut problem, &branch.points, &recorder.tests, SINGULAR_TOLERANCE)
+            .into_iter()
+            .map(|s| {
+                let (omega, xi) = problem.frequency_and_xi(&s.x);
+                BackboneSingularPoint {
+                    kind: s.kind,
+                    amplitude: 10f64.powf(s.lambda),
+                    omega,
+                    xi,
+                    after_point: s.after_point,
+                    located: s.located,
+                }
+            })
+            .collect();
+    // Near a branch point the continuation's small steps can turn it onto the crossing branch
+    // and back, until it runs back along the backbone to the first amplitude (seen on a
+    // structure with four alike joints, where the crossing motions are those in which the
+    // joints stop moving alike). What follows the branch point is then only the way back.
+    let mut turned_back_at = None;
+    if branch.termination == TerminationReason::ReturnedToStart {
+        if let Some(bp) = singular.iter().find(|s| s.kind == SingularKind::BranchPoint).cloned() {
+            points.truncate(bp.after_point + 1);
+            singular.retain(|s| s.after_point < bp.after_point);
+            singular.push(bp.clone());
+            turned_back_at = Some(bp);
+        }
+    }
     Ok(Backbone {
         mode: settings.mode,
         linear_omega: w0,
@@ -889,6 +966,8 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
         points,
         termination: branch.termination.clone(),
         notes: Vec::new(),
+        singular_points: singular,
+        turned_back_at,
         branch: Some(branch),
         viscous: problem.c_t,
         shapes: problem.linear.modes().shapes.clone(),
@@ -944,6 +1023,8 @@ fn linear_backbone(
         linear_damping_ratio: c / (2.0 * omega),
         points,
         termination: TerminationReason::ReachedEnd,
+        singular_points: Vec::new(),
+        turned_back_at: None,
         notes: vec![format!(
             "the model has no joints: its nonlinear mode {} is the linear mode at every amplitude ({:.6} Hz, damping ratio {:.4e})",
             r + 1,
