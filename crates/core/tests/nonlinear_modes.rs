@@ -193,9 +193,6 @@ fn bad_input_is_reported() {
     assert!(e.contains("nonlinear regime") || e.contains("no periodic solution"), "{e}");
     let e = err(run(&model, settings(0, 3, 64), 1e-3, 1e-4));
     assert!(e.contains("amplitude range"), "{e}");
-    let general = table6_1dof(F_COULOMB, true);
-    let e = err(run(&general, settings(0, 3, 64), 1e-6, 1e-3));
-    assert!(e.contains("general damping matrix"), "{e}");
     // No joints: the linear mode, said so.
     let linear = LinearModel::new(
         dense(1, |_, _| MASS),

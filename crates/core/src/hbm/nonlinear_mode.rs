@@ -28,6 +28,24 @@
 //! ```
 //!
 //! With [`NegativeDamping::TargetMode`] the condensed modes keep `c_r` (ξ acts on η only).
+//!
+//! # A damping matrix
+//!
+//! A damping matrix that is not diagonal in the modes (`C = Φᵀ D Φ` full) couples every modal
+//! equation. Per harmonic, with `Z = Λ − (kΩ)² + i kΩ (C − ξ S)` (S the identity, or the
+//! target alone) split into the target (*) and the rest (r), the condensed modes are
+//! `p_r = −W_r0 η − W_rG G` with `W = Z_rr⁻¹ [Z_r*, A_rᵀ]` (one complex LU of size m − 1 per
+//! harmonic and evaluation), and the balance keeps its form with three coefficients:
+//!
+//! ```text
+//! R_u,k = u_k − b_k η_k + H_k G_k,      b_k = a_* − A_r W_r0,   H_k = A_r W_rG
+//! R_η,k = z_k η_k + c_kᵀ G_k,           z_k = Z_** − Z_*r W_r0,  c_k = a_* − (Z_*r W_rG)ᵀ
+//! ```
+//!
+//! With diagonal damping `Z_r* = 0`, so that `b = c = a_*`, `z_k` is the target's own dynamic
+//! stiffness and `H_k` the modal sum above. The derivatives in Ω and ξ reuse the LU
+//! (`∂W = Z_rr⁻¹ ([∂Z_r*, 0] − ∂Z_rr W)`). The linear limit is no longer `(ω_*, c_*)` but the
+//! root of `z_1(Ω, ξ) = 0` ([`NonlinearMode::linear_limit`]).
 //! `G` are the harmonics of the element forces by AFT ([`super::element_aft`]). Elements in the
 //! paper's form (Eq. 11) return forces net of the stiffness they replace in K, so a stuck joint
 //! gives `G = 0` and the linear mode solves the balance exactly.
@@ -57,6 +75,7 @@
 //! The Jacobian is analytic; the λ-derivative follows from `d(G(a û)/a)/dλ = ln 10 (∂G/∂u û −
 //! G/a)`.
 
+use faer::linalg::solvers::Solve;
 use faer::{c64, Mat, MatMut};
 
 use super::condensed::HbmSettings;
@@ -89,8 +108,6 @@ pub enum NonlinearModeError {
     Continuation(#[from] ContinuationError),
     #[error("mode {mode} was asked for, but the model has {available} modes (modes are numbered from 1)")]
     ModeOutOfRange { mode: usize, available: usize },
-    #[error("nonlinear modes need damping that is diagonal in the undamped modes (none, Rayleigh or modal ratios); the model has a general damping matrix")]
-    GeneralDamping,
     #[error("the amplitude range [{start:e}, {end:e}] is not valid: give two positive finite amplitudes, the first the smaller (the branch starts from the linear mode)")]
     InvalidAmplitudes { start: f64, end: f64 },
     #[error("the amplitude range starts in the nonlinear regime: at amplitude {amplitude:e} the mode's frequency departs from the linear {linear_hz:.6} Hz by {frequency_shift:.2e} (relative) and its damping ratio from {linear_ratio:.4e} by {damping_shift:.2e} (relative; accepted: {LINEAR_START_TOLERANCE:e}); start at a smaller amplitude")]
@@ -110,9 +127,25 @@ pub struct NonlinearMode<'m> {
     omega_t: f64,
     c_t: f64,
     a_t: Vec<f64>,
-    /// The linear part: every mode (frequencies, damping, `A = Vᵀ Φ` q × m, the shapes for
-    /// recovery), as the forced balance has it.
-    linear: ModalReceptance,
+    /// The linear part with damping diagonal in the modes, as the forced balance has it: the
+    /// condensed modes' receptance as a modal sum. `None` with a damping matrix.
+    linear: Option<ModalReceptance>,
+    /// Every mode: ω_r, the diagonal of the modal damping `Φᵀ D Φ`, `A = Vᵀ Φ` (q × m) and the
+    /// mass-normalised shapes (n × m).
+    omega_r: Vec<f64>,
+    c_r: Vec<f64>,
+    a_all: Mat<f64>,
+    shapes: Mat<f64>,
+    /// With a damping matrix, the full `C = Φᵀ D Φ` (m × m), which couples the modes.
+    coupled: Option<Mat<f64>>,
+    /// Per harmonic 0..=N: how the target mode meets the joints through the condensed modes
+    /// (module documentation), at the last evaluation.
+    coupling: Vec<TargetCoupling>,
+    /// `W` of harmonic 1 (m × (1 + q), zero row at the target), so that the condensed modes'
+    /// harmonic 1 is `p_r1 = −W_r0 η_1 − Σ_j W_rj G_1j`; and its ∂/∂Ω, ∂/∂ξ.
+    w1: [Mat<c64>; 3],
+    /// `p_r1 / a` at the last evaluation (m).
+    p1: Vec<c64>,
     /// The condensed modes see `−ξ` too ([`NegativeDamping::MassProportional`]).
     shift_all: bool,
     q: usize,
@@ -126,12 +159,7 @@ pub struct NonlinearMode<'m> {
     dh_dxi: Vec<Mat<c64>>,
     /// `∂G/∂u û − G/a` (the amplitude derivative of the scaled forces, over ln 10).
     t: Vec<f64>,
-    /// The condensed modes' share of the amplitude: `N = Σ_{r≠*} a_r a_rᵀ / |den_r(Ω; ξ)|²`
-    /// (q × q) and its derivatives in Ω and ξ (see [`NonlinearMode::amplitude_weights`]).
-    n_w: Mat<f64>,
-    dn_domega: Mat<f64>,
-    dn_dxi: Mat<f64>,
-    /// `N Ĝ_c1` then `N Ĝ_s1` (2q), with `Ĝ = G/a`.
+    /// `∂R_a/∂Ĝ_c1` then `∂R_a/∂Ĝ_s1` (2q), with `Ĝ = G/a`.
     ng: Vec<f64>,
     /// Residual and Jacobian evaluations since creation.
     pub evaluations: usize,
@@ -150,6 +178,17 @@ pub enum NegativeDamping {
     /// damping. The same backbone where the other modes hardly move (a one-mode motion, e.g. a
     /// 1-DOF system), and robust on models with many modes.
     TargetMode,
+}
+
+/// How the target mode meets the joints at one harmonic through the condensed modes: the
+/// motion along the joints `u_k = b_k η_k − H_k G_k`, and the target's balance
+/// `z_k η_k + c_kᵀ G_k = 0` (module documentation). With damping diagonal in the modes,
+/// `b = c = a_*` and `z_k` is the target's own dynamic stiffness. Each as value, ∂/∂Ω, ∂/∂ξ.
+#[derive(Clone, Debug)]
+struct TargetCoupling {
+    b: [Vec<c64>; 3],
+    z: [c64; 3],
+    c: [Vec<c64>; 3],
 }
 
 /// A mode, a harmonic balance and where the branch goes.
@@ -343,16 +382,24 @@ impl<'m> NonlinearMode<'m> {
     /// one element (see [`nonlinear_mode`] for a model without) and modal damping.
     pub fn new(model: &'m NonlinearModel, settings: &NonlinearModeSettings) -> Result<Self, NonlinearModeError> {
         model.check_no_rigid_contacts("the nonlinear mode")?;
-        if !model.linear.damping.is_modal() {
-            return Err(NonlinearModeError::GeneralDamping);
-        }
         let directions: Vec<&[f64]> = model.application_vectors().map(|v| v.as_slice()).collect();
         let q = directions.len();
         let unforced = vec![0.0; model.linear.n_dofs()];
-        let Receptance::Modal(linear) = Receptance::new(&model.linear, &directions, &unforced)? else {
-            return Err(NonlinearModeError::GeneralDamping);
-        };
-        let m = linear.natural_frequencies().len();
+        let (linear, omega_r, c_r, a_all, shapes, coupled) =
+            match Receptance::new(&model.linear, &directions, &unforced)? {
+                Receptance::Modal(l) => {
+                    let (omega_r, c_r) = (l.natural_frequencies().to_vec(), l.damping_coefficients().to_vec());
+                    let (a, shapes) = (l.participation().to_owned(), l.modes().shapes.clone());
+                    (Some(l), omega_r, c_r, a, shapes, None)
+                }
+                Receptance::Direct(d) => {
+                    let c = d.modal_damping();
+                    let omega_r = d.natural_frequencies().to_vec();
+                    let c_r = (0..omega_r.len()).map(|r| c[(r, r)]).collect();
+                    (None, omega_r, c_r, d.participation().to_owned(), d.modes().shapes.clone(), Some(c))
+                }
+            };
+        let m = omega_r.len();
         if settings.mode >= m {
             return Err(NonlinearModeError::ModeOutOfRange { mode: settings.mode + 1, available: m });
         }
@@ -362,13 +409,28 @@ impl<'m> NonlinearMode<'m> {
         let joints = JointForces::new(model, &plan);
         let nh = plan.n_harmonics();
         let zeros = || (0..=nh).map(|_| Mat::<c64>::zeros(q, q)).collect::<Vec<_>>();
+        let a_t: Vec<f64> = (0..q).map(|i| a_all[(i, target)]).collect();
+        let real = |v: &[f64]| v.iter().map(|&x| c64::new(x, 0.0)).collect::<Vec<_>>();
+        let coupling = TargetCoupling {
+            b: [real(&a_t), vec![c64::new(0.0, 0.0); q], vec![c64::new(0.0, 0.0); q]],
+            z: [c64::new(0.0, 0.0); 3],
+            c: [real(&a_t), vec![c64::new(0.0, 0.0); q], vec![c64::new(0.0, 0.0); q]],
+        };
         Ok(NonlinearMode {
             model,
             target,
-            omega_t: linear.natural_frequencies()[target],
-            c_t: linear.damping_coefficients()[target],
-            a_t: (0..q).map(|i| linear.participation()[(i, target)]).collect(),
+            omega_t: omega_r[target],
+            c_t: c_r[target],
+            a_t,
             linear,
+            omega_r,
+            c_r,
+            a_all,
+            shapes,
+            coupled,
+            coupling: vec![coupling; nh + 1],
+            w1: [Mat::zeros(m, q + 1), Mat::zeros(m, q + 1), Mat::zeros(m, q + 1)],
+            p1: vec![c64::new(0.0, 0.0); m],
             shift_all: settings.negative_damping == NegativeDamping::MassProportional,
             q,
             joints,
@@ -377,9 +439,6 @@ impl<'m> NonlinearMode<'m> {
             dh_domega: zeros(),
             dh_dxi: zeros(),
             t: vec![0.0; q * nc],
-            n_w: Mat::zeros(q, q),
-            dn_domega: Mat::zeros(q, q),
-            dn_dxi: Mat::zeros(q, q),
             ng: vec![0.0; 2 * q],
             plan,
             evaluations: 0,
@@ -425,53 +484,45 @@ impl<'m> NonlinearMode<'m> {
         }
     }
 
-    /// The condensed modes' part of the amplitude condition. Their harmonic 1 is
-    /// `p_r1 = −a_rᵀ G_1 / den_r(Ω)`, so `Σ_{r≠*} |p_r1|² = G_1ᴴ N G_1` with the real symmetric
-    ///
-    /// ```text
-    /// N(Ω, ξ) = Σ_{r≠*} a_r a_rᵀ / |den_r|²,   |den_r|² = (ω_r² − Ω²)² + Ω² (c_r − ξ_r)²
-    /// ```
-    ///
-    /// (`ξ_r = ξ` with [`NegativeDamping::MassProportional`], 0 otherwise); `n_w`, `dn_domega`
-    /// and `dn_dxi` receive N, ∂N/∂Ω and ∂N/∂ξ.
-    fn amplitude_weights(&mut self, omega: f64, xi: f64) {
-        let q = self.q;
-        let (omega_r, c_r) = (self.linear.natural_frequencies(), self.linear.damping_coefficients());
-        let a = self.linear.participation();
-        let shift = if self.shift_all { xi } else { 0.0 };
-        self.n_w.fill(0.0);
-        self.dn_domega.fill(0.0);
-        self.dn_dxi.fill(0.0);
-        let o2 = omega * omega;
-        for r in (0..omega_r.len()).filter(|&r| r != self.target) {
-            let (s, c) = (omega_r[r] * omega_r[r] - o2, c_r[r] - shift);
-            let den2 = s * s + o2 * c * c;
-            let inv = 1.0 / den2;
-            // ∂(1/|den|²) = −∂|den|² / |den|⁴.
-            let d_omega = -(-4.0 * omega * s + 2.0 * omega * c * c) * inv * inv;
-            let d_xi = if self.shift_all { 2.0 * o2 * c * inv * inv } else { 0.0 };
-            for j in 0..q {
-                for i in 0..q {
-                    let aa = a[(i, r)] * a[(j, r)];
-                    self.n_w[(i, j)] += aa * inv;
-                    self.dn_domega[(i, j)] += aa * d_omega;
-                    self.dn_dxi[(i, j)] += aa * d_xi;
-                }
+    /// The linear limit of the damped mode: Ω and ξ where the target's balance with every
+    /// joint stuck, `z_1(Ω, ξ) = 0`, holds (Newton's method on the complex equation from the
+    /// undamped mode). With damping diagonal in the modes it is `(ω_*, c_*)` exactly; a damping
+    /// matrix couples the target to the other modes and moves both slightly.
+    pub fn linear_limit(&self) -> (f64, f64) {
+        let (mut omega, mut xi) = (self.omega_t, self.c_t);
+        for _ in 0..50 {
+            let (_, z) = self.coupling_at(1, omega, xi);
+            let det = z[1].re * z[2].im - z[2].re * z[1].im;
+            let d_omega = -(z[0].re * z[2].im - z[2].re * z[0].im) / det;
+            let d_xi = -(z[1].re * z[0].im - z[0].re * z[1].im) / det;
+            omega += d_omega;
+            xi += d_xi;
+            if d_omega.abs() <= 1e-15 * omega && d_xi.abs() <= 1e-15 * omega {
+                break;
             }
         }
+        (omega, xi)
     }
 
-    /// The linear mode at any amplitude, as scaled unknowns: `u/a = a_*` on harmonic 1, `Ω = ω_*`,
-    /// `ξ = c_*`. The exact solution while every joint sticks.
+    /// The linear mode at any amplitude, as scaled unknowns: every joint stuck (`G = 0`), Ω
+    /// and ξ at the linear limit, the target's harmonic 1 and the condensed modes' (dragged
+    /// along by the damping coupling; none with diagonal damping) sharing the amplitude, and
+    /// the joints' motion `u_1 = b_1 η_1`. The exact solution while every joint sticks.
     pub fn linear_guess(&self) -> Vec<f64> {
         let mut y = vec![0.0; self.dimension()];
+        let (omega, xi) = self.linear_limit();
+        let (w, _) = self.coupling_at(1, omega, xi);
+        let m = self.omega_r.len();
+        let e1 = 1.0 / (1.0 + (0..m).map(|r| w[0][(r, 0)].norm_sqr()).sum::<f64>()).sqrt();
         for i in 0..self.q {
-            y[cos_index(1) * self.q + i] = self.a_t[i];
+            let b = c64::new(self.a_t[i], 0.0) - (0..m).map(|r| w[0][(r, 0)] * self.a_all[(i, r)]).sum::<c64>();
+            y[cos_index(1) * self.q + i] = (b * e1).re;
+            y[sin_index(1) * self.q + i] = -(b * e1).im;
         }
-        y[self.eta_column(cos_index(1)).expect("c1 is an unknown")] = 1.0;
+        y[self.eta_column(cos_index(1)).expect("c1 is an unknown")] = e1;
         let iw = self.i_omega();
-        y[iw] = 1.0;
-        y[iw + 1] = self.c_t / self.omega_t;
+        y[iw] = omega / self.omega_t;
+        y[iw + 1] = xi / self.omega_t;
         y
     }
 
@@ -489,32 +540,173 @@ impl<'m> NonlinearMode<'m> {
         self.joints.evaluate(self.model, &self.plan, &self.u, omega, want, false)
     }
 
-    /// `H_rest(kΩ; ξ)` for k = 0..=N and its derivatives in Ω and ξ: the linear part with the
-    /// target mode left out and, for [`NegativeDamping::MassProportional`], the damping
-    /// `−ξ M` added ([`ModalReceptance::matrix_with`]; `∂/∂Ω = k ∂/∂ω`, `∂/∂ξ = −∂/∂α`).
-    fn receptances(&mut self, omega: f64, xi: f64) {
-        let variation = LinearVariation {
-            mass_damping: if self.shift_all { -xi } else { 0.0 },
-            stiffness_damping: 0.0,
-            without_mode: Some(self.target),
+    /// The damping that `−ξ` acts on, `S_rs`: the identity with
+    /// [`NegativeDamping::MassProportional`], the target mode alone otherwise.
+    fn shifted(&self, r: usize, s: usize) -> f64 {
+        match (self.shift_all, r == s, r == self.target) {
+            (_, false, _) => 0.0,
+            (true, true, _) | (false, true, true) => 1.0,
+            (false, true, false) => 0.0,
+        }
+    }
+
+    /// The condensed modes at harmonic k with a damping matrix: with the modal dynamic stiffness
+    /// `Z = Λ − (kΩ)² + i kΩ (C − ξ S)` split into the target (*) and the rest (r),
+    /// `W = Z_rr⁻¹ [Z_r*, A_rᵀ]` (m × (1 + q), zero row at the target) and its ∂/∂Ω (the factor
+    /// k included) and ∂/∂ξ; and `z_k = Z_** − Z_*r W_r0` with its derivatives. With damping
+    /// diagonal in the modes, `W_r0 = 0`, `W_rj = a_jr / den_r` and `z_k` the target's own
+    /// dynamic stiffness, in closed form.
+    fn coupling_at(&self, k: usize, omega: f64, xi: f64) -> ([Mat<c64>; 3], [c64; 3]) {
+        let (q, m, t) = (self.q, self.omega_r.len(), self.target);
+        let (kf, kw) = (k as f64, k as f64 * omega);
+        let zero = c64::new(0.0, 0.0);
+        let damping = |r: usize, s: usize| match &self.coupled {
+            Some(c) => c[(r, s)],
+            None if r == s => self.c_r[r],
+            None => 0.0,
         };
-        let parameters: &[LinearParameter] = match self.shift_all {
-            true => &[LinearParameter::Frequency, LinearParameter::MassDamping],
-            false => &[LinearParameter::Frequency],
+        let z = |r: usize, s: usize| {
+            let diag = if r == s { self.omega_r[r] * self.omega_r[r] - kw * kw } else { 0.0 };
+            c64::new(diag, kw * (damping(r, s) - xi * self.shifted(r, s)))
         };
-        for k in 0..=self.plan.n_harmonics() {
-            let kf = k as f64;
-            let (h, dw, dx) = (self.h[k].as_mut(), &mut self.dh_domega[k], &mut self.dh_dxi[k]);
-            match self.shift_all {
-                true => self.linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut(), dx.as_mut()]),
-                false => {
-                    self.linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut()]);
-                    dx.fill(c64::new(0.0, 0.0));
+        let dz_omega = |r: usize, s: usize| {
+            let diag = if r == s { -2.0 * kf * kw } else { 0.0 };
+            c64::new(diag, kf * (damping(r, s) - xi * self.shifted(r, s)))
+        };
+        let dz_xi = |r: usize, s: usize| c64::new(0.0, -kw * self.shifted(r, s));
+        let mut w = [Mat::zeros(m, q + 1), Mat::zeros(m, q + 1), Mat::zeros(m, q + 1)];
+        let rest: Vec<usize> = (0..m).filter(|&r| r != t).collect();
+        if self.coupled.is_none() || k == 0 {
+            for &r in &rest {
+                let den = z(r, r);
+                let (dw, dx) = (dz_omega(r, r), dz_xi(r, r));
+                for j in 0..q {
+                    let v = c64::new(self.a_all[(j, r)], 0.0) / den;
+                    w[0][(r, j + 1)] = v;
+                    w[1][(r, j + 1)] = -v * dw / den;
+                    w[2][(r, j + 1)] = -v * dx / den;
                 }
             }
-            dw.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v *= kf);
-            dx.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v = -*v);
+            return (w, [z(t, t), dz_omega(t, t), dz_xi(t, t)]);
         }
+        let n = rest.len();
+        let zrr = Mat::from_fn(n, n, |i, j| z(rest[i], rest[j]));
+        let rhs =
+            Mat::from_fn(
+                n,
+                q + 1,
+                |i, j| if j == 0 { z(rest[i], t) } else { c64::new(self.a_all[(j - 1, rest[i])], 0.0) },
+            );
+        let lu = zrr.partial_piv_lu();
+        let sol = lu.solve(&rhs);
+        let mut out = [c64::new(0.0, 0.0); 3];
+        out[0] = z(t, t) - (0..n).map(|i| z(t, rest[i]) * sol[(i, 0)]).sum::<c64>();
+        for (d, dz) in [(1usize, &dz_omega as &dyn Fn(usize, usize) -> c64), (2, &dz_xi)] {
+            // dW = Z_rr⁻¹ ([dZ_r*, 0] − dZ_rr W).
+            let drhs = Mat::from_fn(n, q + 1, |i, j| {
+                let own = if j == 0 { dz(rest[i], t) } else { zero };
+                own - (0..n).map(|l| dz(rest[i], rest[l]) * sol[(l, j)]).sum::<c64>()
+            });
+            let dsol = lu.solve(&drhs);
+            out[d] =
+                dz(t, t) - (0..n).map(|i| dz(t, rest[i]) * sol[(i, 0)] + z(t, rest[i]) * dsol[(i, 0)]).sum::<c64>();
+            for (i, &r) in rest.iter().enumerate() {
+                for j in 0..=q {
+                    w[d][(r, j)] = dsol[(i, j)];
+                }
+            }
+        }
+        for (i, &r) in rest.iter().enumerate() {
+            for j in 0..=q {
+                w[0][(r, j)] = sol[(i, j)];
+            }
+        }
+        (w, out)
+    }
+
+    /// The linear part at Ω and ξ for every harmonic: `H_k` (into `h`, with its derivatives),
+    /// the target's coupling `b_k`, `z_k`, `c_k` and harmonic 1's `W`. With damping diagonal in
+    /// the modes, `H_k` comes from the modal sum ([`ModalReceptance::matrix_with`], the target
+    /// left out, `−ξ M` added for [`NegativeDamping::MassProportional`]; `∂/∂Ω = k ∂/∂ω`,
+    /// `∂/∂ξ = −∂/∂α`); with a damping matrix, from `W` ([`Self::coupling_at`]):
+    /// `H = A_r W_rG`, `b = a_* − A_r W_r0`, `c_j = a_*j − Z_*r W_rj`.
+    fn linear_part(&mut self, omega: f64, xi: f64) {
+        let (q, nh, t) = (self.q, self.plan.n_harmonics(), self.target);
+        let m = self.omega_r.len();
+        if let Some(linear) = &self.linear {
+            let variation = LinearVariation {
+                mass_damping: if self.shift_all { -xi } else { 0.0 },
+                stiffness_damping: 0.0,
+                without_mode: Some(t),
+            };
+            let parameters: &[LinearParameter] = match self.shift_all {
+                true => &[LinearParameter::Frequency, LinearParameter::MassDamping],
+                false => &[LinearParameter::Frequency],
+            };
+            for k in 0..=nh {
+                let kf = k as f64;
+                let (h, dw, dx) = (self.h[k].as_mut(), &mut self.dh_domega[k], &mut self.dh_dxi[k]);
+                match self.shift_all {
+                    true => linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut(), dx.as_mut()]),
+                    false => {
+                        linear.matrix_with(kf * omega, &variation, parameters, h, &mut [dw.as_mut()]);
+                        dx.fill(c64::new(0.0, 0.0));
+                    }
+                }
+                dw.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v *= kf);
+                dx.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v = -*v);
+                self.coupling[k].z = self.target_stiffness(k, omega, xi);
+            }
+            let (w, _) = self.coupling_at(1, omega, xi);
+            self.w1 = w;
+            return;
+        }
+        for k in 0..=nh {
+            let (w, z) = self.coupling_at(k, omega, xi);
+            // Z_*r, its derivatives: the damping coupling of the target to mode r.
+            let kw = k as f64 * omega;
+            let c = self.coupled.as_ref().expect("a damping matrix");
+            let z_tr: Vec<[c64; 3]> = (0..m)
+                .map(|r| {
+                    if r == t {
+                        return [c64::new(0.0, 0.0); 3];
+                    }
+                    let v = c[(t, r)] - xi * self.shifted(t, r);
+                    [c64::new(0.0, kw * v), c64::new(0.0, k as f64 * v), c64::new(0.0, -kw * self.shifted(t, r))]
+                })
+                .collect();
+            let cp = &mut self.coupling[k];
+            cp.z = z;
+            for d in 0..3 {
+                for i in 0..q {
+                    let bi: c64 = (0..m).map(|r| w[d][(r, 0)] * self.a_all[(i, r)]).sum();
+                    cp.b[d][i] = if d == 0 { c64::new(self.a_t[i], 0.0) - bi } else { -bi };
+                    let mut ci: c64 = (0..m).map(|r| z_tr[r][0] * w[d][(r, i + 1)]).sum();
+                    if d > 0 {
+                        ci += (0..m).map(|r| z_tr[r][d] * w[0][(r, i + 1)]).sum::<c64>();
+                    }
+                    cp.c[d][i] = if d == 0 { c64::new(self.a_t[i], 0.0) - ci } else { -ci };
+                }
+                let target = [&mut self.h[k], &mut self.dh_domega[k], &mut self.dh_dxi[k]];
+                let hk = target.into_iter().nth(d).expect("three parts");
+                for i in 0..q {
+                    for j in 0..q {
+                        hk[(i, j)] = (0..m).map(|r| w[d][(r, j + 1)] * self.a_all[(i, r)]).sum();
+                    }
+                }
+            }
+            if k == 1 {
+                self.w1 = w;
+            }
+        }
+    }
+
+    /// `z_k` of the target with damping diagonal in the modes, in closed form (and its ∂/∂Ω,
+    /// ∂/∂ξ): `ω_*² − (kΩ)² + i kΩ (c_* − ξ)`.
+    fn target_stiffness(&self, k: usize, omega: f64, xi: f64) -> [c64; 3] {
+        let (kf, kw) = (k as f64, k as f64 * omega);
+        let c = self.c_t - xi;
+        [c64::new(self.omega_t * self.omega_t - kw * kw, kw * c), c64::new(-2.0 * kf * kw, kf * c), c64::new(0.0, -kw)]
     }
 
     /// Post-process the solution `y` at `λ = log10 a`: frequency, ξ, energies, stick fractions
@@ -527,16 +719,14 @@ impl<'m> NonlinearMode<'m> {
             .map_err(|e| NonlinearModeError::PostProcessing { amplitude, reason: e.message })?;
         let q = self.q;
         let (nh, nc, nt) = (self.plan.n_harmonics(), self.plan.n_coeffs(), self.plan.n_samples());
-        let m = self.linear.natural_frequencies().len();
+        let m = self.omega_r.len();
         let n = self.model.linear.n_dofs();
         let pi = std::f64::consts::PI;
-        let (omega_r, c_r) = (self.linear.natural_frequencies(), self.linear.damping_coefficients());
-        let (a, shapes) = (self.linear.participation(), &self.linear.modes().shapes);
         // Modal coordinates of every mode, harmonic by harmonic: η for the target,
-        // −a_rᵀ G_k / den_r(kΩ) for the others (the condensed modes, recovered).
+        // `−W_r0 η_k − Σ_j W_rj G_kj` for the others (the condensed modes, recovered).
         let mut modal = vec![vec![c64::new(0.0, 0.0); nh + 1]; m];
         for k in 0..=nh {
-            let w = k as f64 * omega;
+            let (w, _) = self.coupling_at(k, omega, xi);
             let gk: Vec<c64> = (0..q)
                 .map(|i| {
                     if k == 0 {
@@ -546,31 +736,36 @@ impl<'m> NonlinearMode<'m> {
                     }
                 })
                 .collect();
+            let eta = if k == 0 {
+                c64::new(amplitude * self.eta(y, 0), 0.0)
+            } else {
+                c64::new(self.eta(y, cos_index(k)), -self.eta(y, sin_index(k))) * amplitude
+            };
             for r in 0..m {
                 modal[r][k] = if r == self.target {
-                    if k == 0 {
-                        c64::new(amplitude * self.eta(y, 0), 0.0)
-                    } else {
-                        c64::new(self.eta(y, cos_index(k)), -self.eta(y, sin_index(k))) * amplitude
-                    }
+                    eta
                 } else {
-                    let shift = if self.shift_all { xi } else { 0.0 };
-                    let den = c64::new(omega_r[r] * omega_r[r] - w * w, w * (c_r[r] - shift));
-                    let load: c64 = (0..q).map(|i| gk[i] * a[(i, r)]).sum();
-                    -load / den
+                    -w[0][(r, 0)] * eta - (0..q).map(|i| w[0][(r, i + 1)] * gk[i]).sum::<c64>()
                 };
             }
         }
-        // Work of −ξ M U̇ and of D over a cycle: ∮ ṗ² dt = π Ω Σ_k k² |P_k|² per mode.
+        // Work of −ξ M U̇ and of D over a cycle: ∮ ṗᵀ C ṗ dt = π Ω Σ_k k² Re(P_kᴴ C P_k).
         let mut supplied = 0.0;
         let mut viscous = 0.0;
-        for r in 0..m {
-            let s: f64 = (1..=nh).map(|k| (k * k) as f64 * modal[r][k].norm_sqr()).sum::<f64>() * pi * omega;
-            if self.shift_all || r == self.target {
-                supplied += xi * s;
+        for k in 1..=nh {
+            let kk = (k * k) as f64 * pi * omega;
+            for r in 0..m {
+                let p = modal[r][k];
+                if self.shift_all || r == self.target {
+                    supplied += xi * kk * p.norm_sqr();
+                }
+                viscous += match &self.coupled {
+                    Some(c) => kk * (0..m).map(|s| c[(r, s)] * (p.conj() * modal[s][k]).re).sum::<f64>(),
+                    None => kk * self.c_r[r] * p.norm_sqr(),
+                };
             }
-            viscous += c_r[r] * s;
         }
+        let shapes = &self.shapes;
         let mut joint_energy = Vec::with_capacity(self.model.elements.len());
         let mut stick_fraction = Vec::with_capacity(self.model.elements.len());
         for (e, site) in self.model.elements.iter().enumerate() {
@@ -639,27 +834,31 @@ impl Problem for NonlinearMode<'_> {
         let q = self.q;
         let nc = self.plan.n_coeffs();
         let nh = self.plan.n_harmonics();
+        let m = self.omega_r.len();
         let amplitude = 10f64.powf(lambda);
         let iw = self.i_omega();
         let (w, xih) = (y[iw], y[iw + 1]);
         let (omega, xi) = (w * self.omega_t, xih * self.omega_t);
-        let ct = self.c_t / self.omega_t;
         let w2 = self.omega_t * self.omega_t;
         let want = jacobian.is_some();
         self.element_forces(y, amplitude, omega, want).map_err(|e| ProblemError::at_trial_iterate(e.to_string()))?;
-        self.receptances(omega, xi);
-        self.amplitude_weights(omega, xi);
+        self.linear_part(omega, xi);
         let inv_a = 1.0 / amplitude;
         let base = q * nc;
-        // R_u (scaled by 1/a): û − a_* η̂ + H_rest G/a.
+        let (c1, s1) = (cos_index(1), sin_index(1));
+        let row_a = base + nc;
+        // A complex harmonic `v (x_c − i x_s)` as its (cos, sin) parts.
+        let times = |v: c64, xc: f64, xs: f64| (v.re * xc + v.im * xs, -v.im * xc + v.re * xs);
+        let g = &self.joints.g;
+        // R_u (scaled by 1/a): û − b η̂ + H G/a.
         for k in 0..=nh {
-            let h = &self.h[k];
+            let (h, b) = (&self.h[k], &self.coupling[k].b[0]);
             if k == 0 {
                 let e0 = self.eta(y, 0);
                 for i in 0..q {
-                    let mut r = y[i] - self.a_t[i] * e0;
+                    let mut r = y[i] - b[i].re * e0;
                     for j in 0..q {
-                        r += h[(i, j)].re * self.joints.g[j] * inv_a;
+                        r += h[(i, j)].re * g[j] * inv_a;
                     }
                     residual[i] = r;
                 }
@@ -668,52 +867,54 @@ impl Problem for NonlinearMode<'_> {
             let (ic, is) = (cos_index(k), sin_index(k));
             let (ec, es) = (self.eta(y, ic), self.eta(y, is));
             for i in 0..q {
-                let mut rc = y[ic * q + i] - self.a_t[i] * ec;
-                let mut rs = y[is * q + i] - self.a_t[i] * es;
+                let (bc, bs) = times(b[i], ec, es);
+                let (mut rc, mut rs) = (y[ic * q + i] - bc, y[is * q + i] - bs);
                 for j in 0..q {
-                    let (gc, gs) = (self.joints.g[ic * q + j] * inv_a, self.joints.g[is * q + j] * inv_a);
-                    rc += h[(i, j)].re * gc + h[(i, j)].im * gs;
-                    rs += -h[(i, j)].im * gc + h[(i, j)].re * gs;
+                    let (hc, hs) = times(h[(i, j)], g[ic * q + j] * inv_a, g[is * q + j] * inv_a);
+                    rc += hc;
+                    rs += hs;
                 }
                 residual[ic * q + i] = rc;
                 residual[is * q + i] = rs;
             }
         }
-        // R_η (scaled by 1/(a ω_*²)): D_k η̂_k + a_*ᵀ G_k/(a ω_*²), D_k/ω_*² = 1 − (kw)² + i kw(c̃ − ξ̂).
-        let proj = |g: &[f64], c: usize| -> f64 { (0..q).map(|i| self.a_t[i] * g[c * q + i]).sum::<f64>() };
-        residual[base] = self.eta(y, 0) + proj(&self.joints.g, 0) * inv_a / w2;
-        for k in 1..=nh {
-            let kw = k as f64 * w;
-            let (zr, zi) = (1.0 - kw * kw, kw * (ct - xih));
+        // R_η (scaled by 1/(a ω_*²)): z_k η̂_k / ω_*² + c_kᵀ G_k/(a ω_*²).
+        for k in 0..=nh {
+            let cp = &self.coupling[k];
+            let zz = cp.z[0] / w2;
+            if k == 0 {
+                let e0 = self.eta(y, 0);
+                residual[base] = zz.re * e0 + (0..q).map(|i| cp.c[0][i].re * g[i]).sum::<f64>() * inv_a / w2;
+                continue;
+            }
             let (ic, is) = (cos_index(k), sin_index(k));
-            let (ec, es) = (self.eta(y, ic), self.eta(y, is));
-            residual[base + ic] = zr * ec + zi * es + proj(&self.joints.g, ic) * inv_a / w2;
-            residual[base + is] = -zi * ec + zr * es + proj(&self.joints.g, is) * inv_a / w2;
+            let (mut rc, mut rs) = times(zz, self.eta(y, ic), self.eta(y, is));
+            for i in 0..q {
+                let (gc, gs) = times(cp.c[0][i], g[ic * q + i] * inv_a / w2, g[is * q + i] * inv_a / w2);
+                rc += gc;
+                rs += gs;
+            }
+            residual[base + ic] = rc;
+            residual[base + is] = rs;
         }
-        // R_a = |η̂_1|² + Ĝ_1ᴴ N Ĝ_1 − 1: the mass norm of harmonic 1 of the whole motion,
-        // `X_1ᴴ M X_1 = Σ_r |p_r1|²` in mass-normalised modes, is a² (Krack 2015, Eq. 4).
-        let (c1, s1) = (cos_index(1), sin_index(1));
-        let row_a = base + nc;
-        let g_hat = |g: &[f64], part: usize, j: usize| g[part * q + j] * inv_a;
-        for i in 0..q {
-            self.ng[i] = (0..q).map(|j| self.n_w[(i, j)] * g_hat(&self.joints.g, c1, j)).sum();
-            self.ng[q + i] = (0..q).map(|j| self.n_w[(i, j)] * g_hat(&self.joints.g, s1, j)).sum();
-        }
-        let quadratic = |n: &Mat<f64>, g: &[f64]| -> f64 {
-            [c1, s1]
-                .iter()
-                .map(|&part| {
-                    (0..q)
-                        .map(|i| g_hat(g, part, i) * (0..q).map(|j| n[(i, j)] * g_hat(g, part, j)).sum::<f64>())
-                        .sum::<f64>()
-                })
-                .sum()
-        };
+        // R_a = |η̂_1|² + Σ_{r≠*} |p̂_r1|² − 1, p̂_r1 = −W_r0 η̂_1 − Σ_j W_rj Ĝ_1j: the mass norm
+        // of harmonic 1 of the whole motion, `X_1ᴴ M X_1 = Σ_r |p_r1|²` in mass-normalised
+        // modes, is a² (Krack 2015, Eq. 4).
         let e1 = self.eta(y, c1);
-        residual[row_a] = e1 * e1 + quadratic(&self.n_w, &self.joints.g) - 1.0;
+        let g1: Vec<c64> = (0..q).map(|j| c64::new(g[c1 * q + j], -g[s1 * q + j]) * inv_a).collect();
+        for r in 0..m {
+            self.p1[r] = -self.w1[0][(r, 0)] * e1 - (0..q).map(|j| self.w1[0][(r, j + 1)] * g1[j]).sum::<c64>();
+        }
+        residual[row_a] = e1 * e1 + self.p1.iter().map(|p| p.norm_sqr()).sum::<f64>() - 1.0;
         let Some((mut dy, dl)) = jacobian else { return Ok(()) };
 
-        // ∂/∂û: I + H_rest ∂G/∂u on R_u, a_*ᵀ ∂G/∂u / ω_*² on R_η (∂(G(aû)/a)/∂û = ∂G/∂u).
+        // ∂R_a/∂Ĝ_1: 2 Re(p̂ᴴ ∂p̂/∂Ĝ), ∂p̂/∂ĝ_c = −W_rj, ∂p̂/∂ĝ_s = i W_rj.
+        for j in 0..q {
+            let v: c64 = (0..m).map(|r| self.p1[r].conj() * self.w1[0][(r, j + 1)]).sum();
+            self.ng[j] = -2.0 * v.re;
+            self.ng[q + j] = -2.0 * v.im;
+        }
+        // ∂/∂û: I + H ∂G/∂u on R_u, cᵀ ∂G/∂u / ω_*² on R_η (∂(G(aû)/a)/∂û = ∂G/∂u), and R_a's.
         // ∂G/∂u is block diagonal over elements; t = ∂G/∂u û − G/a is built on the way.
         for i in 0..base {
             dy[(i, i)] = 1.0;
@@ -724,27 +925,37 @@ impl Problem for NonlinearMode<'_> {
             let off = self.joints.offsets[e];
             let je = &self.joints.elem_jac[e];
             for c2 in 0..nc {
-                for b in 0..d {
-                    let col = c2 * q + off + b;
-                    let ecol = c2 * d + b;
+                for bb in 0..d {
+                    let col = c2 * q + off + bb;
+                    let ecol = c2 * d + bb;
                     let ub = y[col];
                     for c in 0..nc {
                         for a in 0..d {
                             self.t[c * q + off + a] += je[(c * d + a, ecol)] * ub;
                         }
                     }
-                    // R_η rows.
-                    for c in 0..nc {
-                        let v: f64 = (0..d).map(|a| self.a_t[off + a] * je[(c * d + a, ecol)]).sum();
-                        dy[(base + c, col)] += v / w2;
+                    // R_η rows, harmonic 0 then k ≥ 1.
+                    let c0 = &self.coupling[0].c[0];
+                    dy[(base, col)] += (0..d).map(|a| c0[off + a].re * je[(a, ecol)]).sum::<f64>() / w2;
+                    for k in 1..=nh {
+                        let ck = &self.coupling[k].c[0];
+                        let (ic, is) = (cos_index(k), sin_index(k));
+                        let (mut vc, mut vs) = (0.0, 0.0);
+                        for a in 0..d {
+                            let (pc, ps) = times(ck[off + a], je[(ic * d + a, ecol)], je[(is * d + a, ecol)]);
+                            vc += pc;
+                            vs += ps;
+                        }
+                        dy[(base + ic, col)] += vc / w2;
+                        dy[(base + is, col)] += vs / w2;
                     }
-                    // R_a row: 2 (N Ĝ_1)ᴴ ∂G_1/∂u.
+                    // R_a row.
                     let v: f64 = (0..d)
                         .map(|a| {
                             self.ng[off + a] * je[(c1 * d + a, ecol)] + self.ng[q + off + a] * je[(s1 * d + a, ecol)]
                         })
                         .sum();
-                    dy[(row_a, col)] += 2.0 * v;
+                    dy[(row_a, col)] += v;
                     // R_u rows, harmonic 0 then k ≥ 1.
                     for i in 0..q {
                         let v: f64 = (0..d).map(|a| self.h[0][(i, off + a)].re * je[(a, ecol)]).sum();
@@ -756,10 +967,9 @@ impl Problem for NonlinearMode<'_> {
                         for i in 0..q {
                             let (mut vc, mut vs) = (0.0, 0.0);
                             for a in 0..d {
-                                let hh = h[(i, off + a)];
-                                let (gc, gs) = (je[(ic * d + a, ecol)], je[(is * d + a, ecol)]);
-                                vc += hh.re * gc + hh.im * gs;
-                                vs += -hh.im * gc + hh.re * gs;
+                                let (pc, ps) = times(h[(i, off + a)], je[(ic * d + a, ecol)], je[(is * d + a, ecol)]);
+                                vc += pc;
+                                vs += ps;
                             }
                             dy[(ic * q + i, col)] += vc;
                             dy[(is * q + i, col)] += vs;
@@ -768,104 +978,134 @@ impl Problem for NonlinearMode<'_> {
                 }
             }
         }
-        // ∂/∂η̂ (free coefficients): −a_* on R_u, D_k/ω_*² on R_η.
+        // ∂/∂η̂ (free coefficients): −b on R_u, z/ω_*² on R_η; 2 η̂_c1 + 2 Re(p̂ᴴ(−W_r0)) on R_a.
         for c in 0..nc {
-            if let Some(col) = self.eta_column(c) {
-                for i in 0..q {
-                    dy[(c * q + i, col)] = -self.a_t[i];
-                }
-            }
-        }
-        dy[(base, base)] = 1.0;
-        for k in 1..=nh {
-            let kw = k as f64 * w;
-            let (zr, zi) = (1.0 - kw * kw, kw * (ct - xih));
-            let (ic, is) = (cos_index(k), sin_index(k));
-            if let Some(cc) = self.eta_column(ic) {
-                dy[(base + ic, cc)] = zr;
-                dy[(base + is, cc)] = -zi;
-            }
-            if let Some(cs) = self.eta_column(is) {
-                dy[(base + ic, cs)] = zi;
-                dy[(base + is, cs)] = zr;
-            }
-        }
-        dy[(row_a, self.eta_column(c1).expect("c1 is an unknown"))] = 2.0 * e1;
-        // ∂/∂w = ω_* ∂/∂Ω and ∂/∂ξ̂ = ω_* ∂/∂ξ.
-        let wt = self.omega_t;
-        for k in 0..=nh {
-            let (h, dh, dx) = (&self.h[k], &self.dh_domega[k], &self.dh_dxi[k]);
+            let Some(col) = self.eta_column(c) else { continue };
+            let k = c.div_ceil(2);
+            let cp = &self.coupling[k];
             if k == 0 {
                 for i in 0..q {
-                    let v: f64 = (0..q).map(|j| h[(i, j)].re * self.joints.dg_domega[j]).sum();
-                    dy[(i, iw)] += wt * v * inv_a;
+                    dy[(i, col)] = -cp.b[0][i].re;
                 }
+                dy[(base, col)] = cp.z[0].re / w2;
                 continue;
             }
             let (ic, is) = (cos_index(k), sin_index(k));
+            // The column of η̂_c (x_c = 1) or η̂_s (x_s = 1).
+            let (xc, xs) = if c == ic { (1.0, 0.0) } else { (0.0, 1.0) };
             for i in 0..q {
-                let (mut wc, mut ws, mut xc, mut xs) = (0.0, 0.0, 0.0, 0.0);
+                let (vc, vs) = times(cp.b[0][i], xc, xs);
+                dy[(ic * q + i, col)] = -vc;
+                dy[(is * q + i, col)] = -vs;
+            }
+            let (vc, vs) = times(cp.z[0] / w2, xc, xs);
+            dy[(base + ic, col)] = vc;
+            dy[(base + is, col)] = vs;
+        }
+        let pw0: c64 = (0..m).map(|r| self.p1[r].conj() * self.w1[0][(r, 0)]).sum();
+        dy[(row_a, self.eta_column(c1).expect("c1 is an unknown"))] = 2.0 * e1 - 2.0 * pw0.re;
+        // ∂/∂w = ω_* ∂/∂Ω and ∂/∂ξ̂ = ω_* ∂/∂ξ.
+        let wt = self.omega_t;
+        let dg = &self.joints.dg_domega;
+        for k in 0..=nh {
+            let (h, dh, dx) = (&self.h[k], &self.dh_domega[k], &self.dh_dxi[k]);
+            let cp = &self.coupling[k];
+            if k == 0 {
+                for i in 0..q {
+                    let v: f64 = (0..q).map(|j| h[(i, j)].re * dg[j]).sum();
+                    dy[(i, iw)] += wt * v * inv_a;
+                }
+                dy[(base, iw)] += wt * (0..q).map(|i| cp.c[0][i].re * dg[i]).sum::<f64>() * inv_a / w2;
+                continue;
+            }
+            let (ic, is) = (cos_index(k), sin_index(k));
+            let (ec, es) = (self.eta(y, ic), self.eta(y, is));
+            for i in 0..q {
+                // R_u: −∂b η̂ + ∂H Ĝ + H ∂Ĝ/∂Ω.
+                let (bwc, bws) = times(cp.b[1][i], ec, es);
+                let (bxc, bxs) = times(cp.b[2][i], ec, es);
+                let (mut wc, mut ws, mut xc, mut xs) = (-bwc, -bws, -bxc, -bxs);
                 for j in 0..q {
-                    let (gc, gs) = (self.joints.g[ic * q + j] * inv_a, self.joints.g[is * q + j] * inv_a);
-                    let (dgc, dgs) =
-                        (self.joints.dg_domega[ic * q + j] * inv_a, self.joints.dg_domega[is * q + j] * inv_a);
-                    let (hh, dd, xx) = (h[(i, j)], dh[(i, j)], dx[(i, j)]);
-                    wc += dd.re * gc + dd.im * gs + hh.re * dgc + hh.im * dgs;
-                    ws += -dd.im * gc + dd.re * gs - hh.im * dgc + hh.re * dgs;
-                    xc += xx.re * gc + xx.im * gs;
-                    xs += -xx.im * gc + xx.re * gs;
+                    let (gc, gs) = (g[ic * q + j] * inv_a, g[is * q + j] * inv_a);
+                    let (dgc, dgs) = (dg[ic * q + j] * inv_a, dg[is * q + j] * inv_a);
+                    let (a1, a2) = times(dh[(i, j)], gc, gs);
+                    let (b1, b2) = times(h[(i, j)], dgc, dgs);
+                    let (x1, x2) = times(dx[(i, j)], gc, gs);
+                    wc += a1 + b1;
+                    ws += a2 + b2;
+                    xc += x1;
+                    xs += x2;
                 }
                 dy[(ic * q + i, iw)] += wt * wc;
                 dy[(is * q + i, iw)] += wt * ws;
                 dy[(ic * q + i, iw + 1)] += wt * xc;
                 dy[(is * q + i, iw + 1)] += wt * xs;
             }
+            // R_η: ∂z η̂ + ∂cᵀ Ĝ + cᵀ ∂Ĝ/∂Ω, over ω_*².
+            let (mut wc, mut ws) = times(cp.z[1], ec, es);
+            let (mut xc, mut xs) = times(cp.z[2], ec, es);
+            for i in 0..q {
+                let (gc, gs) = (g[ic * q + i] * inv_a, g[is * q + i] * inv_a);
+                let (dgc, dgs) = (dg[ic * q + i] * inv_a, dg[is * q + i] * inv_a);
+                let (a1, a2) = times(cp.c[1][i], gc, gs);
+                let (b1, b2) = times(cp.c[0][i], dgc, dgs);
+                let (x1, x2) = times(cp.c[2][i], gc, gs);
+                wc += a1 + b1;
+                ws += a2 + b2;
+                xc += x1;
+                xs += x2;
+            }
+            dy[(base + ic, iw)] += wt * wc / w2;
+            dy[(base + is, iw)] += wt * ws / w2;
+            dy[(base + ic, iw + 1)] += wt * xc / w2;
+            dy[(base + is, iw + 1)] += wt * xs / w2;
         }
-        dy[(base, iw)] += wt * proj(&self.joints.dg_domega, 0) * inv_a / w2;
-        for k in 1..=nh {
-            let kf = k as f64;
-            let (ic, is) = (cos_index(k), sin_index(k));
-            let (ec, es) = (self.eta(y, ic), self.eta(y, is));
-            // d(D_k/ω_*²)/dw = −2k²w + i k (c̃ − ξ̂); d(D_k/ω_*²)/dξ̂ = −i k w.
-            let (zr, zi) = (-2.0 * kf * kf * w, kf * (ct - xih));
-            dy[(base + ic, iw)] += zr * ec + zi * es + wt * proj(&self.joints.dg_domega, ic) * inv_a / w2;
-            dy[(base + is, iw)] += -zi * ec + zr * es + wt * proj(&self.joints.dg_domega, is) * inv_a / w2;
-            let zi = -kf * w;
-            dy[(base + ic, iw + 1)] += zi * es;
-            dy[(base + is, iw + 1)] += -zi * ec;
-        }
-        // ∂/∂λ = ln 10 [H_rest t; a_*ᵀ t / ω_*²].
+        // R_a: 2 Re(p̂ᴴ (−∂W_r0 η̂_1 − ∂W_rG Ĝ_1)) + ∂R_a/∂Ĝ ∂Ĝ/∂Ω.
+        let dp = |d: usize| -> f64 {
+            let v: c64 = (0..m)
+                .map(|r| {
+                    let dpr = -self.w1[d][(r, 0)] * e1 - (0..q).map(|j| self.w1[d][(r, j + 1)] * g1[j]).sum::<c64>();
+                    self.p1[r].conj() * dpr
+                })
+                .sum();
+            2.0 * v.re
+        };
+        let cross = |v: &[f64], scale: f64| -> f64 {
+            (0..q).map(|i| self.ng[i] * v[c1 * q + i] + self.ng[q + i] * v[s1 * q + i]).sum::<f64>() * scale
+        };
+        dy[(row_a, iw)] += wt * (dp(1) + cross(dg, inv_a));
+        dy[(row_a, iw + 1)] += wt * dp(2);
+        // ∂/∂λ = ln 10 [H t; cᵀ t / ω_*²; ∂R_a/∂Ĝ t].
         for k in 0..=nh {
-            let h = &self.h[k];
+            let (h, cp) = (&self.h[k], &self.coupling[k]);
             if k == 0 {
                 for i in 0..q {
                     dl[i] = LN_10 * (0..q).map(|j| h[(i, j)].re * self.t[j]).sum::<f64>();
                 }
+                dl[base] = LN_10 * (0..q).map(|i| cp.c[0][i].re * self.t[i]).sum::<f64>() / w2;
                 continue;
             }
             let (ic, is) = (cos_index(k), sin_index(k));
             for i in 0..q {
                 let (mut vc, mut vs) = (0.0, 0.0);
                 for j in 0..q {
-                    let (tc, ts) = (self.t[ic * q + j], self.t[is * q + j]);
-                    vc += h[(i, j)].re * tc + h[(i, j)].im * ts;
-                    vs += -h[(i, j)].im * tc + h[(i, j)].re * ts;
+                    let (a1, a2) = times(h[(i, j)], self.t[ic * q + j], self.t[is * q + j]);
+                    vc += a1;
+                    vs += a2;
                 }
                 dl[ic * q + i] = LN_10 * vc;
                 dl[is * q + i] = LN_10 * vs;
             }
+            let (mut vc, mut vs) = (0.0, 0.0);
+            for i in 0..q {
+                let (a1, a2) = times(cp.c[0][i], self.t[ic * q + i], self.t[is * q + i]);
+                vc += a1;
+                vs += a2;
+            }
+            dl[base + ic] = LN_10 * vc / w2;
+            dl[base + is] = LN_10 * vs / w2;
         }
-        for c in 0..nc {
-            dl[base + c] = LN_10 * proj(&self.t, c) / w2;
-        }
-        // R_a in w, ξ̂ and λ: ∂Ĝ/∂Ω = ∂G/∂Ω / a, ∂Ĝ/∂λ = ln 10 t.
-        let cross = |g: &[f64], scale: f64| -> f64 {
-            (0..q).map(|i| self.ng[i] * g[c1 * q + i] + self.ng[q + i] * g[s1 * q + i]).sum::<f64>() * scale
-        };
-        dy[(row_a, iw)] +=
-            wt * (2.0 * cross(&self.joints.dg_domega, inv_a) + quadratic(&self.dn_domega, &self.joints.g));
-        dy[(row_a, iw + 1)] += wt * quadratic(&self.dn_dxi, &self.joints.g);
-        dl[row_a] = 2.0 * LN_10 * cross(&self.t, 1.0);
+        dl[row_a] = LN_10 * cross(&self.t, 1.0);
         Ok(())
     }
 
@@ -914,7 +1154,8 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
     }
     let first = &branch.points[0];
     let (omega, xi) = problem.frequency_and_xi(&first.x);
-    let (w0, z0) = (problem.linear_omega(), problem.linear_damping_ratio());
+    let (w0, xi0) = problem.linear_limit();
+    let z0 = xi0 / (2.0 * w0);
     let frequency_shift = (omega / w0 - 1.0).abs();
     let zeta = xi / (2.0 * omega);
     let damping_shift = (zeta - z0).abs() / z0.max(1e-3);
@@ -970,11 +1211,13 @@ pub fn nonlinear_mode<'m, O: PointObserver<NonlinearMode<'m>> + ?Sized>(
         turned_back_at,
         branch: Some(branch),
         viscous: problem.c_t,
-        shapes: problem.linear.modes().shapes.clone(),
+        shapes: problem.shapes.clone(),
     })
 }
 
-/// The linear mode at the ends of the amplitude range (a model without joints).
+/// The linear mode at the ends of the amplitude range (a model without joints): the linear
+/// limit of the balance ([`NonlinearMode::linear_limit`], which a damping matrix moves off the
+/// undamped mode), its motion recovered at both amplitudes.
 fn linear_backbone(
     model: &NonlinearModel,
     settings: &NonlinearModeSettings,
@@ -982,45 +1225,18 @@ fn linear_backbone(
     amplitude_end: f64,
     outputs: &[&[f64]],
 ) -> Result<Backbone, NonlinearModeError> {
-    if !model.linear.damping.is_modal() {
-        return Err(NonlinearModeError::GeneralDamping);
-    }
-    let modes = model.linear.dense_modes()?;
-    let r = settings.mode;
-    if r >= modes.omega.len() {
-        return Err(NonlinearModeError::ModeOutOfRange { mode: r + 1, available: modes.omega.len() });
-    }
-    let omega = modes.omega[r];
-    let c = model.linear.damping.modal_coefficient(r, omega).expect("modal damping");
-    let n = model.linear.n_dofs();
-    let nc = 2 * settings.hbm.harmonics + 1;
+    let mut problem = NonlinearMode::new(model, settings)?;
+    let y = problem.linear_guess();
+    let (omega, xi) = problem.linear_limit();
     let points = [amplitude_start, amplitude_end]
         .iter()
-        .map(|&a| BackbonePoint {
-            amplitude: a,
-            omega,
-            xi: c,
-            // ∮ c ṗ² dt = π c ω a² for p = a cos ωt.
-            energy_per_cycle: std::f64::consts::PI * c * omega * a * a,
-            supplied_energy: std::f64::consts::PI * c * omega * a * a,
-            joint_energy: Vec::new(),
-            stick_fraction: Vec::new(),
-            outputs: outputs
-                .iter()
-                .map(|o| {
-                    let mut v = vec![0.0; nc];
-                    v[cos_index(1)] = a * (0..n).map(|l| o[l] * modes.shapes[(l, r)]).sum::<f64>();
-                    v
-                })
-                .collect(),
-            modal_harmonic1: (0..modes.omega.len()).map(|s| c64::new(if s == r { a } else { 0.0 }, 0.0)).collect(),
-            y: Vec::new(),
-        })
-        .collect();
+        .map(|a| problem.point(&y, a.log10(), outputs))
+        .collect::<Result<Vec<_>, _>>()?;
+    let r = settings.mode;
     Ok(Backbone {
         mode: r,
         linear_omega: omega,
-        linear_damping_ratio: c / (2.0 * omega),
+        linear_damping_ratio: xi / (2.0 * omega),
         points,
         termination: TerminationReason::ReachedEnd,
         singular_points: Vec::new(),
@@ -1029,10 +1245,10 @@ fn linear_backbone(
             "the model has no joints: its nonlinear mode {} is the linear mode at every amplitude ({:.6} Hz, damping ratio {:.4e})",
             r + 1,
             omega / (2.0 * std::f64::consts::PI),
-            c / (2.0 * omega)
+            xi / (2.0 * omega)
         )],
         branch: None,
-        viscous: c,
-        shapes: modes.shapes.clone(),
+        viscous: problem.c_t,
+        shapes: problem.shapes.clone(),
     })
 }

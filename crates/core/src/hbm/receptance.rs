@@ -525,6 +525,11 @@ impl DirectReceptance {
         self.a.as_ref()
     }
 
+    /// The mass-normalised undamped modes.
+    pub fn modes(&self) -> &Modes {
+        &self.modes
+    }
+
     fn dynamic_stiffness(&self, omega: f64) -> Mat<c64> {
         let n = self.mass.nrows();
         Mat::from_fn(n, n, |i, j| {
