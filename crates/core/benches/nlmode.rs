@@ -48,7 +48,7 @@ fn main() {
             let stick = p1.stick_fraction.iter().cloned().fold(f64::INFINITY, f64::min);
             println!(
             "{n} DOFs, q = 4, modal amplitude {a0:e}-{a1:e}, {steps}: {:>8.3} ms/backbone {:>4} points {:>7.1} us/point {:.2} Newton it/point; \
-             {:.3} -> {:.3} Hz, damping ratio {:.4} -> {:.4} (max {:.4}), least stick fraction at the end {stick:.2}; {}",
+             {:.3} -> {:.3} Hz, damping ratio {:.4} -> {:.4} (max {:.4}), least stick fraction at the end {stick:.2}, {} folds or branch points; {}",
             times[runs / 2] * 1e3,
             b.points.len(),
             times[runs / 2] * 1e6 / b.points.len() as f64,
@@ -58,6 +58,7 @@ fn main() {
             p0.damping_ratio(),
             p1.damping_ratio(),
             b.points.iter().map(|p| p.damping_ratio()).fold(0.0, f64::max),
+            b.singular_points.len(),
             b.termination
         );
         }

@@ -657,8 +657,21 @@ impl<'m> NonlinearMode<'m> {
                 dx.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v = -*v);
                 self.coupling[k].z = self.target_stiffness(k, omega, xi);
             }
-            let (w, _) = self.coupling_at(1, omega, xi);
-            self.w1 = w;
+            // Harmonic 1's W in place: `W_rj = a_jr / den_r`, one division a mode.
+            let shift = if self.shift_all { xi } else { 0.0 };
+            let [w, dw, dx] = &mut self.w1;
+            for r in (0..m).filter(|&r| r != t) {
+                let c = self.c_r[r] - shift;
+                let inv = c64::new(1.0, 0.0) / c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * c);
+                let (d_omega, d_xi) =
+                    (c64::new(-2.0 * omega, c) * inv, c64::new(0.0, if self.shift_all { -omega } else { 0.0 }) * inv);
+                for j in 0..q {
+                    let v = inv * self.a_all[(j, r)];
+                    w[(r, j + 1)] = v;
+                    dw[(r, j + 1)] = -v * d_omega;
+                    dx[(r, j + 1)] = -v * d_xi;
+                }
+            }
             return;
         }
         for k in 0..=nh {
@@ -725,8 +738,12 @@ impl<'m> NonlinearMode<'m> {
         // Modal coordinates of every mode, harmonic by harmonic: η for the target,
         // `−W_r0 η_k − Σ_j W_rj G_kj` for the others (the condensed modes, recovered).
         let mut modal = vec![vec![c64::new(0.0, 0.0); nh + 1]; m];
+        let shift = if self.shift_all { xi } else { 0.0 };
         for k in 0..=nh {
-            let (w, _) = self.coupling_at(k, omega, xi);
+            // W of this harmonic: by the LU of the other modes with a damping matrix, else the
+            // modal sum's `a_jr / den_r` (W_r0 = 0), without derivatives.
+            let w = self.coupled.as_ref().map(|_| self.coupling_at(k, omega, xi).0);
+            let kw = k as f64 * omega;
             let gk: Vec<c64> = (0..q)
                 .map(|i| {
                     if k == 0 {
@@ -742,10 +759,13 @@ impl<'m> NonlinearMode<'m> {
                 c64::new(self.eta(y, cos_index(k)), -self.eta(y, sin_index(k))) * amplitude
             };
             for r in 0..m {
-                modal[r][k] = if r == self.target {
-                    eta
-                } else {
-                    -w[0][(r, 0)] * eta - (0..q).map(|i| w[0][(r, i + 1)] * gk[i]).sum::<c64>()
+                modal[r][k] = match &w {
+                    _ if r == self.target => eta,
+                    Some(w) => -w[0][(r, 0)] * eta - (0..q).map(|i| w[0][(r, i + 1)] * gk[i]).sum::<c64>(),
+                    None => {
+                        let den = c64::new(self.omega_r[r] * self.omega_r[r] - kw * kw, kw * (self.c_r[r] - shift));
+                        -(0..q).map(|i| gk[i] * self.a_all[(i, r)]).sum::<c64>() / den
+                    }
                 };
             }
         }
