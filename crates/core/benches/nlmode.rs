@@ -7,18 +7,37 @@ mod common;
 use std::time::Instant;
 
 use common::chain_with_joints;
+use faer::Mat;
 use stickslip_core::continuation::{Options, Silent};
 use stickslip_core::hbm::{nonlinear_mode, HbmSettings, NegativeDamping, NonlinearModeSettings};
+use stickslip_core::model::{Damping, Matrix};
 
 fn main() {
     let quick = std::env::args().any(|a| a == "quick");
-    let runs = if quick { 3 } else { 11 };
+    let runs = if quick || std::env::args().any(|a| a == "damping-matrix") { 3 } else { 11 };
     faer::set_global_parallelism(faer::Par::Seq);
     println!("stickslip nonlinear mode benchmark: N = 7, 300 samples, one thread, median of {runs} runs");
     let mass = std::env::args().any(|a| a == "mass");
     let negative_damping = if mass { NegativeDamping::MassProportional } else { NegativeDamping::TargetMode };
-    for n in [137, 149] {
-        let model = chain_with_joints(n, 4, false);
+    // `damping-matrix`: the 137-DOF chain's D = αM written as a matrix with a dashpot added
+    // across it (DOF 10 to DOF 70, 20 N·s/m), so that Φᵀ D Φ is full and the balance takes the
+    // coupled path (one complex LU of the other 136 modes per harmonic and evaluation).
+    let coupled = std::env::args().any(|a| a == "damping-matrix");
+    for n in if coupled { vec![137] } else { vec![137, 149] } {
+        let mut model = chain_with_joints(n, 4, false);
+        if coupled {
+            let Damping::Rayleigh { alpha, .. } = model.linear.damping else {
+                unreachable!("the chain's damping is αM")
+            };
+            let mass = model.linear.mass.to_dense();
+            let dashpot = |i: usize, j: usize| match (i, j) {
+                (10, 10) | (70, 70) => 20.0,
+                (10, 70) | (70, 10) => -20.0,
+                _ => 0.0,
+            };
+            model.linear.damping =
+                Damping::Matrix(Matrix::Dense(Mat::from_fn(n, n, |i, j| alpha * mass[(i, j)] + dashpot(i, j))));
+        }
         let settings =
             NonlinearModeSettings { mode: 0, hbm: HbmSettings { harmonics: 7, samples: 300 }, negative_damping };
         // Four decades, from the stuck mode to joints slipping over most of the cycle. The
