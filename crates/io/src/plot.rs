@@ -340,6 +340,16 @@ fn is_unstable(p: &PointRecord) -> bool {
     p.stability.is_some_and(|s| !s.stable)
 }
 
+/// `" (unstable)"` for a point known to be unstable, else empty: the titles of the plots of
+/// one point (hysteresis, slider velocity) say what the FRF plots show by dashes.
+fn unstable_note(p: &PointRecord) -> &'static str {
+    if is_unstable(p) {
+        " (unstable)"
+    } else {
+        ""
+    }
+}
+
 /// `"dashed: unstable"` when a curve has an unstable stretch, else empty: the titles of the
 /// FRF, phase and harmonics plots say what the dashes mean.
 fn dashed_note(curves: &[Curve]) -> &'static str {
@@ -504,7 +514,7 @@ pub fn plot_hysteresis(path: &Path, level_n: f64, point: &PointRecord, element: 
         points.push(p);
     }
     Chart {
-        title: format!("Hysteresis of {element} at {:.4} Hz, {level_n} N", point.frequency_hz),
+        title: format!("Hysteresis of {element} at {:.4} Hz, {level_n} N{}", point.frequency_hz, unstable_note(point)),
         x_label: "Displacement (m)".into(),
         y_label: "Force (N)".into(),
         log_y: false,
@@ -521,7 +531,11 @@ pub fn plot_slider_velocity(path: &Path, level_n: f64, point: &PointRecord, elem
     let period_ms = 1e3 / point.frequency_hz;
     let points = e.slider_velocity.iter().enumerate().map(|(j, &v)| (period_ms * j as f64 / n_t as f64, v)).collect();
     Chart {
-        title: format!("Slider velocity of {element} at {:.4} Hz, {level_n} N", point.frequency_hz),
+        title: format!(
+            "Slider velocity of {element} at {:.4} Hz, {level_n} N{}",
+            point.frequency_hz,
+            unstable_note(point)
+        ),
         x_label: "Time (ms)".into(),
         y_label: "Velocity (m/s)".into(),
         log_y: false,
@@ -1193,6 +1207,37 @@ mod tests {
             Vec::new()
         };
         LevelResult { level_n, points, bifurcations, ..Default::default() }
+    }
+
+    /// The plots of one point (hysteresis, slider velocity) say in their titles when the point
+    /// is unstable, as the FRF plots dash it; a stable point's titles do not.
+    #[test]
+    fn plots_of_an_unstable_point_say_so_in_their_titles() {
+        use crate::output::{ElementRecord, PointRecord, PointStability};
+        let dir = std::env::temp_dir().join(format!("stickslip-plot-unstable-point-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let point = |stable: bool| PointRecord {
+            frequency_hz: 230.0,
+            elements: vec![ElementRecord {
+                name: "blade1".into(),
+                loop_u: vec![0.0, 1e-5, 0.0, -1e-5],
+                loop_force: vec![0.0, 290.0, 0.0, -290.0],
+                slider_velocity: vec![0.0, 1e-3, 0.0, -1e-3],
+                ..ElementRecord::default()
+            }],
+            stability: Some(PointStability { stable, exponent_re: if stable { -1.0 } else { 2.0 }, exponent_im: 0.0 }),
+            ..PointRecord::default()
+        };
+        for stable in [true, false] {
+            let (h, v) = (dir.join(format!("h{stable}.svg")), dir.join(format!("v{stable}.svg")));
+            super::plot_hysteresis(&h, 2910.0, &point(stable), "blade1").unwrap();
+            super::plot_slider_velocity(&v, 2910.0, &point(stable), "blade1").unwrap();
+            for path in [h, v] {
+                let svg = std::fs::read_to_string(&path).unwrap();
+                assert_eq!(svg.contains("(unstable)"), !stable, "{}", path.display());
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// The fold of a level is marked on its phase curve (at the phase the curve has there, past
