@@ -854,6 +854,20 @@ pub fn describe_termination(t: &TerminationReason) -> String {
     describe_termination_with(t, None)
 }
 
+/// Why a backbone ended, for users (the command line and Python): where it turned back at a
+/// branch point, that point; otherwise its branch's termination.
+pub fn backbone_ending(backbone: &Backbone) -> String {
+    match &backbone.turned_back_at {
+        Some(bp) => format!(
+            "turned back at a branch point at modal amplitude {:.4e} m·√kg, {:.4} Hz, damping ratio {:.4e} (another family of periodic motions crosses the backbone there; with alike joints, one where they stop moving alike) and the backbone is written up to it; the forced responses are the reference beyond",
+            bp.amplitude,
+            bp.omega / TWO_PI,
+            bp.damping_ratio()
+        ),
+        None => describe_backbone_termination(&backbone.termination),
+    }
+}
+
 /// Say why a backbone ended, for users: its branch is continued in `log10` of the modal
 /// amplitude, not in frequency, so its stops are said in amplitude.
 pub fn describe_backbone_termination(t: &TerminationReason) -> String {

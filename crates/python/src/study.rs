@@ -7,8 +7,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
+use stickslip_core::continuation::TerminationReason;
 use stickslip_core::timesim::{steady_state, SteadyStateOptions};
-use stickslip_io::analysis::{LevelRun, LevelSweeper};
+use stickslip_io::analysis::{backbone_ending, run_nonlinear_mode, LevelRun, LevelSweeper};
+use stickslip_io::backbone::{backbone_columns, backbone_rows, singular_kind_name};
 use stickslip_io::output::{frf_columns, frf_row, LevelResult, PointRecord};
 use stickslip_io::study::Study as IoStudy;
 
@@ -181,6 +183,78 @@ impl PyStudy {
         d.set_item("periods", s.periods)?;
         d.set_item("periodicity", s.periodicity)?;
         d.set_item("dissipated_J", s.energy.dissipated())?;
+        Ok(d)
+    }
+
+    /// The backbone of the study's `[nonlinear_mode]` (docs/nonlinear-modes.md). `progress`, if
+    /// given, is called as `progress(modal_amplitude)` after each converged point. Returns a
+    /// dict: `columns` and `table` (those of `backbone.csv`, one row per point), `bifurcations`
+    /// (its folds in amplitude and branch points, as `backbone_bifurcations.csv`), `complete`
+    /// (the last amplitude reached), `ending` (why the branch ended, as the command line says
+    /// it), `notes`, and the linear mode's `linear_frequency_Hz` and `linear_damping_ratio`.
+    /// A branch that stops short is returned with its points, `complete` false.
+    #[pyo3(signature = (progress=None))]
+    fn nonlinear_mode<'py>(&self, py: Python<'py>, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
+        let study = &self.study;
+        if study.nonlinear_mode.is_none() {
+            return Err(StudyError::new_err(format!(
+                "{}: the study has no [nonlinear_mode] section (keys: mode, amplitude_start, amplitude_end; see docs/nonlinear-modes.md)",
+                study.path.display()
+            )));
+        }
+        let callback_error: std::sync::Mutex<Option<PyErr>> = std::sync::Mutex::new(None);
+        let solved = py.detach(|| {
+            guarded(|| {
+                let (model, _, outputs) = study.build_model().map_err(study_error)?;
+                let mut observer = |p: &Point, _: f64| {
+                    let Some(cb) = &progress else { return };
+                    let mut failed = callback_error.lock().unwrap_or_else(|e| e.into_inner());
+                    if failed.is_none() {
+                        if let Err(e) = Python::attach(|py| cb.call1(py, (10f64.powf(p.lambda),)).map(|_| ())) {
+                            *failed = Some(e);
+                        }
+                    }
+                };
+                let result =
+                    run_nonlinear_mode(study, &model, &outputs, &mut observer).expect("the section is present");
+                let (backbone, names) =
+                    result.map_err(|e| SolveError::new_err(format!("nonlinear mode: {}", chain(&e))))?;
+                let joints: Vec<String> = model.elements.iter().map(|e| e.name.clone()).collect();
+                Ok((backbone, names, joints))
+            })
+        })?;
+        if let Some(e) = callback_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            return Err(e);
+        }
+        let (backbone, names, joints) = solved;
+        let harmonics = study.hbm.harmonics;
+        let columns = backbone_columns(&joints, &names, harmonics);
+        let rows = backbone_rows(&backbone, joints.len(), harmonics);
+        let table = PyArray2::from_vec2(py, &rows).map_err(|e| SolveError::new_err(e.to_string()))?;
+        let d = PyDict::new(py);
+        d.set_item("columns", columns)?;
+        d.set_item("table", table)?;
+        let bifurcations = backbone
+            .singular_points
+            .iter()
+            .map(|s| {
+                let b = PyDict::new(py);
+                b.set_item("kind", singular_kind_name(s.kind))?;
+                b.set_item("modal_amplitude_m_sqrtkg", s.amplitude)?;
+                b.set_item("frequency_Hz", s.omega / (2.0 * std::f64::consts::PI))?;
+                b.set_item("damping_ratio", s.damping_ratio())?;
+                b.set_item("located", s.located)?;
+                Ok(b)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        d.set_item("bifurcations", bifurcations)?;
+        let complete =
+            matches!(backbone.termination, TerminationReason::ReachedEnd) && backbone.turned_back_at.is_none();
+        d.set_item("complete", complete)?;
+        d.set_item("ending", backbone_ending(&backbone))?;
+        d.set_item("notes", backbone.notes.clone())?;
+        d.set_item("linear_frequency_Hz", backbone.linear_omega / (2.0 * std::f64::consts::PI))?;
+        d.set_item("linear_damping_ratio", backbone.linear_damping_ratio)?;
         Ok(d)
     }
 

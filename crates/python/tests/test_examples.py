@@ -128,3 +128,34 @@ def test_an_exception_in_the_progress_callback_reaches_the_caller(root):
     # Levels run in parallel: whichever level calls first raises.
     with pytest.raises(RuntimeError, match=r"stop at \d+\.0 N"):
         study.run(progress=progress)
+
+
+def test_the_backbone_equals_the_command_lines(root, cli, tmp_path):
+    """`Study.nonlinear_mode` gives the command line's backbone.csv (Table 6's backbone, the
+    example's [nonlinear_mode]): the same library code, so the same numbers to the file's
+    precision (backbone.csv holds 11 significant digits: 1e-10 relative), and the same folds
+    and branch points (none on this single-mode branch)."""
+    path = root / "examples" / "jenkins-1dof" / "study.toml"
+    p = cli("nlmode", path, "--out", tmp_path / "out", "--quiet", "--no-plots")
+    assert p.returncode == 0, p.stderr
+    expected = pd.read_csv(tmp_path / "out" / "backbone.csv")
+    seen = []
+    backbone = stickslip.Study.from_toml(path).nonlinear_mode(progress=seen.append)
+    frame = backbone.to_pandas()
+    assert list(frame.columns) == list(expected.columns)
+    assert len(frame) == len(expected) == len(seen) > 10
+    np.testing.assert_allclose(frame.to_numpy(float), expected.to_numpy(float), rtol=1e-10, atol=0)
+    assert backbone.complete and backbone.bifurcations == []
+    singular = pd.read_csv(tmp_path / "out" / "backbone_bifurcations.csv")
+    assert len(singular) == 0
+    # The stuck backbone is the linear mode: 238.2 Hz (docs/nonlinear-modes.md), its damping
+    # ratio d / (2 M ω) in closed form.
+    assert abs(backbone.frequency_hz[0] / backbone.linear_frequency_hz - 1) < 1e-10
+    w = 2 * np.pi * backbone.linear_frequency_hz
+    assert abs(backbone.linear_damping_ratio / (350.0 / (2 * 10.0 * w)) - 1) < 1e-12
+
+
+def test_a_study_without_a_nonlinear_mode_section_is_refused(root):
+    study = stickslip.Study.from_toml(root / "examples" / "duffing" / "study.toml")
+    with pytest.raises(stickslip.StudyError, match=r"no \[nonlinear_mode\] section"):
+        study.nonlinear_mode()

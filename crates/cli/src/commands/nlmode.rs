@@ -6,9 +6,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 use stickslip_core::continuation::Point;
-use stickslip_core::hbm::Backbone;
 use stickslip_core::model::NonlinearModel;
-use stickslip_io::analysis::{describe_backbone_termination, run_nonlinear_mode};
+use stickslip_io::analysis::{backbone_ending, run_nonlinear_mode};
 use stickslip_io::backbone::{
     single_mode_frfs, singular_kind_name, write_backbone_csv, write_backbone_singular_csv, write_single_mode_csv,
 };
@@ -118,26 +117,13 @@ pub fn compute_and_write(
             last.frequency_hz(),
             first.damping_ratio(),
             last.damping_ratio(),
-            why_it_ended(&backbone),
+            backbone_ending(&backbone),
             started.elapsed().as_secs_f64(),
             if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
         );
     }
     if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
-        anyhow::bail!("nonlinear mode: the branch {} (its points are written)", why_it_ended(&backbone));
+        anyhow::bail!("nonlinear mode: the branch {} (its points are written)", backbone_ending(&backbone));
     }
     Ok(files)
-}
-
-/// Why the backbone ended, for users: where it turned back at a branch point, that point.
-fn why_it_ended(backbone: &Backbone) -> String {
-    match &backbone.turned_back_at {
-        Some(bp) => format!(
-            "turned back at a branch point at modal amplitude {:.4e} m·√kg, {:.4} Hz, damping ratio {:.4e} (another family of periodic motions crosses the backbone there; with alike joints, one where they stop moving alike) and the backbone is written up to it; the forced responses are the reference beyond",
-            bp.amplitude,
-            bp.omega / (2.0 * std::f64::consts::PI),
-            bp.damping_ratio()
-        ),
-        None => describe_backbone_termination(&backbone.termination),
-    }
 }

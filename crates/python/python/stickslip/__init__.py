@@ -24,10 +24,11 @@ from ._stickslip import (
     modes,
     reduce,
 )
-from ._study import Results, Study
+from ._study import Backbone, Results, Study
 from .params import ParamResults, design, run_parameters
 
 __all__ = [
+    "Backbone",
     "Error",
     "InputError",
     "ParamError",

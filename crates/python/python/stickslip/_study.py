@@ -62,6 +62,18 @@ class Study:
         return self._native.timesim(float(frequency_hz), float(level_n), int(steps_per_period),
                                     float(tolerance), int(max_periods))
 
+    def nonlinear_mode(self, progress=None, strict: bool = False) -> "Backbone":
+        """The backbone of the study's ``[nonlinear_mode]`` (damped nonlinear mode, EPMC):
+        frequency, damping ratio, energy, stick fractions and harmonics against the modal
+        amplitude, as the command line's ``backbone.csv``. ``progress(modal_amplitude)`` is
+        called after each converged point. A branch that stops short is kept and marked
+        (``Backbone.complete``, ``Backbone.ending``); with ``strict=True`` it raises
+        :class:`SolveError` as the command line does."""
+        backbone = Backbone(self._native.nonlinear_mode(progress))
+        if strict and not backbone.complete:
+            raise SolveError(f"nonlinear mode: the branch {backbone.ending} (its points are kept)")
+        return backbone
+
     def __reduce__(self):
         # Studies travel to worker processes as their dict and path.
         return (_from_dict_and_path, (self.to_dict(), self.path))
@@ -169,3 +181,54 @@ class Results:
     def __repr__(self) -> str:
         return (f"Results({len(self)} points, levels {[lv['level_N'] for lv in self.levels]} N, "
                 f"outputs {self.outputs}, elements {self.elements})")
+
+
+class Backbone:
+    """A damped nonlinear mode: the numbers of the command line's ``backbone.csv`` (same
+    columns, units in the names) as a NumPy table, one row per point."""
+
+    def __init__(self, data: dict):
+        self.columns: list = list(data["columns"])
+        self.table: np.ndarray = data["table"]
+        #: Folds in amplitude and branch points (``kind``, ``modal_amplitude_m_sqrtkg``,
+        #: ``frequency_Hz``, ``damping_ratio``, ``located``), as ``backbone_bifurcations.csv``.
+        self.bifurcations: list = data["bifurcations"]
+        #: Whether the branch reached ``amplitude_end``; ``ending`` says why it ended.
+        self.complete: bool = data["complete"]
+        self.ending: str = data["ending"]
+        self.notes: list = data["notes"]
+        self.linear_frequency_hz: float = data["linear_frequency_Hz"]
+        self.linear_damping_ratio: float = data["linear_damping_ratio"]
+
+    def column(self, name: str) -> np.ndarray:
+        try:
+            return self.table[:, self.columns.index(name)]
+        except ValueError:
+            raise KeyError(f"no column {name!r}; columns are: {', '.join(self.columns)}") from None
+
+    @property
+    def amplitude(self) -> np.ndarray:
+        """Modal amplitude (m·√kg): the mass norm of harmonic 1 of the motion."""
+        return self.column("modal_amplitude_m_sqrtkg")
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return self.column("frequency_Hz")
+
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        return self.column("damping_ratio")
+
+    def to_pandas(self):
+        """The table as a pandas DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame(self.table, columns=self.columns)
+
+    def __len__(self) -> int:
+        return self.table.shape[0]
+
+    def __repr__(self) -> str:
+        f = self.frequency_hz
+        return (f"Backbone({len(self)} points, {f[0]:.4f} -> {f[-1]:.4f} Hz, "
+                f"{'complete' if self.complete else 'incomplete: ' + self.ending})")
