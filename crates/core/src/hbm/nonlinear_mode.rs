@@ -203,8 +203,8 @@ pub struct NonlinearModeSettings {
 /// One point of a backbone: the damped nonlinear mode at one amplitude.
 #[derive(Clone, Debug)]
 pub struct BackbonePoint {
-    /// Modal amplitude a: the cosine of harmonic 1 of the mass-normalised modal coordinate
-    /// (m·√kg).
+    /// Modal amplitude a (m·√kg): the mass norm of harmonic 1 of the whole motion,
+    /// `a² = X_1ᴴ M X_1` (Krack 2015, Eq. 4).
     pub amplitude: f64,
     /// Ω (rad/s).
     pub omega: f64,
