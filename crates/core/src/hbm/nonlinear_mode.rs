@@ -144,8 +144,9 @@ pub struct NonlinearMode<'m> {
     /// `W` of harmonic 1 (m × (1 + q), zero row at the target), so that the condensed modes'
     /// harmonic 1 is `p_r1 = −W_r0 η_1 − Σ_j W_rj G_1j`; and its ∂/∂Ω, ∂/∂ξ.
     w1: [Mat<c64>; 3],
-    /// `p_r1 / a` at the last evaluation (m).
+    /// `p_r1 / a` at the last evaluation (m), and `G_1 / a` (q).
     p1: Vec<c64>,
+    g1: Vec<c64>,
     /// The condensed modes see `−ξ` too ([`NegativeDamping::MassProportional`]).
     shift_all: bool,
     q: usize,
@@ -431,6 +432,7 @@ impl<'m> NonlinearMode<'m> {
             coupling: vec![coupling; nh + 1],
             w1: [Mat::zeros(m, q + 1), Mat::zeros(m, q + 1), Mat::zeros(m, q + 1)],
             p1: vec![c64::new(0.0, 0.0); m],
+            g1: vec![c64::new(0.0, 0.0); q],
             shift_all: settings.negative_damping == NegativeDamping::MassProportional,
             q,
             joints,
@@ -921,7 +923,10 @@ impl Problem for NonlinearMode<'_> {
         // of harmonic 1 of the whole motion, `X_1ᴴ M X_1 = Σ_r |p_r1|²` in mass-normalised
         // modes, is a² (Krack 2015, Eq. 4).
         let e1 = self.eta(y, c1);
-        let g1: Vec<c64> = (0..q).map(|j| c64::new(g[c1 * q + j], -g[s1 * q + j]) * inv_a).collect();
+        for j in 0..q {
+            self.g1[j] = c64::new(g[c1 * q + j], -g[s1 * q + j]) * inv_a;
+        }
+        let g1 = &self.g1;
         for r in 0..m {
             self.p1[r] = -self.w1[0][(r, 0)] * e1 - (0..q).map(|j| self.w1[0][(r, j + 1)] * g1[j]).sum::<c64>();
         }
