@@ -29,6 +29,22 @@
 //!
 //! With [`NegativeDamping::TargetMode`] the condensed modes keep `c_r` (ξ acts on η only).
 //!
+//! `G` are the harmonics of the element forces by AFT ([`super::element_aft`]). Elements in the
+//! paper's form (Eq. 11) return forces net of the stiffness they replace in K, so a stuck joint
+//! gives `G = 0` and the linear mode solves the balance exactly.
+//!
+//! The phase is fixed by `η_s1 = 0` (a fixed value, not an unknown) and the amplitude by the
+//! mass norm of harmonic 1 of the whole motion (Krack 2015, Eqs. 3-4):
+//!
+//! ```text
+//! R_a = X_1ᴴ M X_1 / a² − 1 = |η_1|² / a² + Σ_{r≠*} |p_r1|² / a² − 1,    p_r1 = −a_rᵀ G_1 / den_r(Ω; ξ)
+//! ```
+//!
+//! (with a damping matrix, `p_r1 = −W_r0 η_1 − W_rG G_1`, below), so that `a` measures the motion, not only the target mode's share of it, which falls where
+//! slipping joints move the other modes (on a model with many modes it can even fall while the
+//! motion grows). The continuation parameter is `λ = log10 a`, so a branch spans decades of
+//! amplitude with steps of even relative size.
+//!
 //! # A damping matrix
 //!
 //! A damping matrix that is not diagonal in the modes (`C = Φᵀ D Φ` full) couples every modal
@@ -46,21 +62,6 @@
 //! stiffness and `H_k` the modal sum above. The derivatives in Ω and ξ reuse the LU
 //! (`∂W = Z_rr⁻¹ ([∂Z_r*, 0] − ∂Z_rr W)`). The linear limit is no longer `(ω_*, c_*)` but the
 //! root of `z_1(Ω, ξ) = 0` ([`NonlinearMode::linear_limit`]).
-//! `G` are the harmonics of the element forces by AFT ([`super::element_aft`]). Elements in the
-//! paper's form (Eq. 11) return forces net of the stiffness they replace in K, so a stuck joint
-//! gives `G = 0` and the linear mode solves the balance exactly.
-//!
-//! The phase is fixed by `η_s1 = 0` (a fixed value, not an unknown) and the amplitude by the
-//! mass norm of harmonic 1 of the whole motion (Krack 2015, Eqs. 3-4):
-//!
-//! ```text
-//! R_a = X_1ᴴ M X_1 / a² − 1 = |η_1|² / a² + Σ_{r≠*} |p_r1|² / a² − 1,    p_r1 = −a_rᵀ G_1 / den_r(Ω; ξ)
-//! ```
-//!
-//! so that `a` measures the motion, not only the target mode's share of it, which falls where
-//! slipping joints move the other modes (on a model with many modes it can even fall while the
-//! motion grows). The continuation parameter is `λ = log10 a`, so a branch spans decades of
-//! amplitude with steps of even relative size.
 //!
 //! # Scaled unknowns
 //!
@@ -451,12 +452,14 @@ impl<'m> NonlinearMode<'m> {
         &self.plan
     }
 
-    /// The linear mode's circular frequency ω_* (rad/s).
+    /// The undamped target mode's circular frequency ω_* (rad/s), the scale of the unknowns;
+    /// the damped linear limit, where the branch starts, is [`Self::linear_limit`].
     pub fn linear_omega(&self) -> f64 {
         self.omega_t
     }
 
-    /// The linear mode's damping ratio `c_* / (2 ω_*)`.
+    /// The undamped target mode's damping ratio `c_* / (2 ω_*)` (`c_*` the diagonal of `Φᵀ D Φ`);
+    /// with damping diagonal in the modes, that of the linear limit.
     pub fn linear_damping_ratio(&self) -> f64 {
         self.c_t / (2.0 * self.omega_t)
     }
