@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
 use stickslip_core::continuation::Point;
 use stickslip_core::model::NonlinearModel;
 use stickslip_io::analysis::{backbone_ending, run_nonlinear_mode};
@@ -59,15 +60,21 @@ pub fn compute_and_write(
     forced: Option<(&[f64], &[LevelResult])>,
 ) -> anyhow::Result<Vec<PathBuf>> {
     let started = Instant::now();
-    let mut observer = |p: &Point, _: f64| {
-        if !quiet {
-            eprint!("\rnonlinear mode: modal amplitude {:.3e}   ", 10f64.powf(p.lambda));
-        }
+    let Some(spec) = &study.nonlinear_mode else { return Ok(Vec::new()) };
+    // A bar over the amplitude range (in log a, as the branch is continued), as the sweeps'.
+    let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>10} [{bar:30}] {percent:>3}% {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(format!("mode {}", spec.mode));
+    let mut observer = |p: &Point, done: f64| {
+        bar.set_position((done * 1000.0) as u64);
+        bar.set_message(format!("modal amplitude {:.3e} m·√kg", 10f64.powf(p.lambda)));
     };
     let Some(result) = run_nonlinear_mode(study, model, outputs, &mut observer) else { return Ok(Vec::new()) };
-    if !quiet {
-        eprintln!();
-    }
+    bar.finish_and_clear();
     let (backbone, names) = result.context("nonlinear mode")?;
     for note in &backbone.notes {
         eprintln!("nonlinear mode: {note}");
