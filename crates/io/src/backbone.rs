@@ -58,6 +58,8 @@ pub fn write_backbone_csv(
     let columns = backbone_columns(joints, outputs, harmonics);
     let mut text = columns.join(",");
     text.push('\n');
+    // Shortest round-trip digits, as frf.csv: the file reads back to the same doubles.
+    let mut digits = ryu::Buffer::new();
     for (i, row) in backbone_rows(backbone, joints.len(), harmonics).iter().enumerate() {
         for (c, v) in row.iter().enumerate() {
             if !v.is_finite() {
@@ -71,7 +73,7 @@ pub fn write_backbone_csv(
             if c > 0 {
                 text.push(',');
             }
-            let _ = write!(text, "{v:.10e}");
+            crate::output::csv::push_number(&mut text, *v, &mut digits);
         }
         text.push('\n');
     }
@@ -83,6 +85,7 @@ pub fn write_backbone_csv(
 /// `located`), the header alone when there is none.
 pub fn write_backbone_singular_csv(path: &Path, backbone: &Backbone) -> Result<(), OutputError> {
     let mut text = String::from("kind,modal_amplitude_m_sqrtkg,frequency_Hz,damping_ratio,located\n");
+    let mut digits = ryu::Buffer::new();
     for s in &backbone.singular_points {
         let values = [s.amplitude, s.omega / (2.0 * std::f64::consts::PI), s.damping_ratio()];
         if let Some(v) = values.iter().find(|v| !v.is_finite()) {
@@ -93,15 +96,12 @@ pub fn write_backbone_singular_csv(path: &Path, backbone: &Backbone) -> Result<(
                 value: *v,
             });
         }
-        let _ = writeln!(
-            text,
-            "{},{:.10e},{:.10e},{:.10e},{}",
-            singular_kind_name(s.kind),
-            values[0],
-            values[1],
-            values[2],
-            s.located
-        );
+        text.push_str(singular_kind_name(s.kind));
+        for v in values {
+            text.push(',');
+            crate::output::csv::push_number(&mut text, v, &mut digits);
+        }
+        let _ = writeln!(text, ",{}", s.located);
     }
     std::fs::write(path, text).map_err(|source| OutputError::Io { path: path.to_path_buf(), source })
 }

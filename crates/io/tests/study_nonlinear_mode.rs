@@ -95,6 +95,12 @@ fn backbone_of_a_study_is_written() {
     assert!(header
         .starts_with("modal_amplitude_m_sqrtkg,frequency_Hz,damping_ratio,energy_per_cycle_J,joint_stick_fraction"));
     assert_eq!(text.lines().count(), backbone.points.len() + 1);
+    // Shortest round-trip digits: the file reads back to the very doubles of the rows.
+    let rows = stickslip_io::backbone::backbone_rows(&backbone, 1, 7);
+    for (line, row) in text.lines().skip(1).zip(&rows) {
+        let read: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(&read, row);
+    }
     #[cfg(feature = "plot")]
     {
         let files = stickslip_io::plot::plot_backbone(&dir, &backbone, stickslip_io::study::PlotFormat::Svg).unwrap();

@@ -7,7 +7,7 @@
 //! round-trip exponent form (`{:e}`'s form, `ryu`'s digits in the tables: `csv::push_number`),
 //! so reading a file back gives the same `f64` bit for bit.
 
-mod csv;
+pub(crate) mod csv;
 mod manifest;
 mod npz;
 
