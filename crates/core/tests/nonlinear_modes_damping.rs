@@ -7,7 +7,7 @@ mod hbm_support;
 
 use faer::{c64, Mat};
 use hbm_support::*;
-use stickslip_core::continuation::{Options, Problem, Silent, TerminationReason};
+use stickslip_core::continuation::{Options, Silent, TerminationReason};
 use stickslip_core::elements::{Element, Jenkins};
 use stickslip_core::hbm::{
     nonlinear_mode, Backbone, HbmSettings, NegativeDamping, NonlinearMode, NonlinearModeSettings,
@@ -148,37 +148,11 @@ fn jacobian_matches_central_differences_with_a_damping_matrix() {
     let model = chain3(dashpot_across);
     for negative_damping in [NegativeDamping::MassProportional, NegativeDamping::TargetMode] {
         let mut p = NonlinearMode::new(&model, &settings(negative_damping)).unwrap();
-        let n = p.dimension();
         let mut y = p.linear_guess();
         for (i, v) in y.iter_mut().enumerate() {
             *v += 0.01 * (i as f64 * 1.7).sin();
         }
-        let lambda = -3.7;
-        let mut r = vec![0.0; n];
-        let mut jac = Mat::zeros(n, n);
-        let mut dl = vec![0.0; n];
-        p.evaluate(&y, lambda, &mut r, Some((jac.as_mut(), &mut dl))).unwrap();
-        let scale = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).fold(0.0f64, |s, (i, j)| s.max(jac[(i, j)].abs()));
-        let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
-        let mut worst = 0.0f64;
-        for j in 0..=n {
-            let h = 1e-6;
-            let (mut yp, mut ym) = (y.clone(), y.clone());
-            let (lp, lm) = if j < n {
-                yp[j] += h;
-                ym[j] -= h;
-                (lambda, lambda)
-            } else {
-                (lambda + h, lambda - h)
-            };
-            p.evaluate(&yp, lp, &mut rp, None).unwrap();
-            p.evaluate(&ym, lm, &mut rm, None).unwrap();
-            for i in 0..n {
-                let fd = (rp[i] - rm[i]) / (2.0 * h);
-                let an = if j < n { jac[(i, j)] } else { dl[i] };
-                worst = worst.max((fd - an).abs());
-            }
-        }
+        let (worst, scale) = jacobian_against_central_differences(&mut p, &y, -3.7, 1e-6);
         eprintln!(
             "{negative_damping:?}: worst |analytic − central difference| {:.2e} of the largest entry",
             worst / scale

@@ -147,3 +147,39 @@ pub fn full_balance_distance(
     let diff: Vec<f64> = x.iter().zip(recovered).map(|(a, b)| a - b).collect();
     norm(&diff) / norm(&x)
 }
+
+/// The worst difference between the analytic Jacobian of `problem` at `(y, λ)` (the unknowns'
+/// columns, then the λ-column) and central differences of step `h`, with the largest entry of
+/// the analytic Jacobian: `(worst, largest)`.
+pub fn jacobian_against_central_differences<P: stickslip_core::continuation::Problem>(
+    problem: &mut P,
+    y: &[f64],
+    lambda: f64,
+    h: f64,
+) -> (f64, f64) {
+    let n = problem.dimension();
+    let (mut r, mut jac, mut dl) = (vec![0.0; n], Mat::zeros(n, n), vec![0.0; n]);
+    problem.evaluate(y, lambda, &mut r, Some((jac.as_mut(), &mut dl))).unwrap();
+    let largest = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max(jac[(i, j)].abs()));
+    let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+    let mut worst = 0.0f64;
+    for j in 0..=n {
+        let (mut yp, mut ym) = (y.to_vec(), y.to_vec());
+        let (mut lp, mut lm) = (lambda, lambda);
+        if j < n {
+            yp[j] += h;
+            ym[j] -= h;
+        } else {
+            lp += h;
+            lm -= h;
+        }
+        problem.evaluate(&yp, lp, &mut rp, None).unwrap();
+        problem.evaluate(&ym, lm, &mut rm, None).unwrap();
+        for i in 0..n {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            let an = if j < n { jac[(i, j)] } else { dl[i] };
+            worst = worst.max((fd - an).abs());
+        }
+    }
+    (worst, largest)
+}

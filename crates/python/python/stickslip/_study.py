@@ -86,7 +86,24 @@ def _from_dict_and_path(d, path):
     return Study.from_dict(d, path)
 
 
-class Results:
+class _Table:
+    """A command line table as NumPy: ``columns`` (units in the names) and ``table``, one row
+    per point."""
+
+    columns: list
+    table: np.ndarray
+
+    def column(self, name: str) -> np.ndarray:
+        try:
+            return self.table[:, self.columns.index(name)]
+        except ValueError:
+            raise KeyError(f"no column {name!r}; columns are: {', '.join(self.columns)}") from None
+
+    def __len__(self) -> int:
+        return self.table.shape[0]
+
+
+class Results(_Table):
     """The converged points of every level of a run: the numbers of the command line's
     ``frf.csv`` (same columns, units in the names) as a NumPy table."""
 
@@ -100,12 +117,6 @@ class Results:
         self.outputs: list = data["outputs"]
         self.elements: list = data["elements"]
         self.harmonics: int = data["harmonics"]
-
-    def column(self, name: str) -> np.ndarray:
-        try:
-            return self.table[:, self.columns.index(name)]
-        except ValueError:
-            raise KeyError(f"no column {name!r}; columns are: {', '.join(self.columns)}") from None
 
     @property
     def frequency_hz(self) -> np.ndarray:
@@ -175,15 +186,12 @@ class Results:
         frame["newton_iterations"] = frame["newton_iterations"].astype("int64")
         return frame
 
-    def __len__(self) -> int:
-        return self.table.shape[0]
-
     def __repr__(self) -> str:
         return (f"Results({len(self)} points, levels {[lv['level_N'] for lv in self.levels]} N, "
                 f"outputs {self.outputs}, elements {self.elements})")
 
 
-class Backbone:
+class Backbone(_Table):
     """A damped nonlinear mode: the numbers of the command line's ``backbone.csv`` (same
     columns, units in the names) as a NumPy table, one row per point."""
 
@@ -199,12 +207,6 @@ class Backbone:
         self.notes: list = data["notes"]
         self.linear_frequency_hz: float = data["linear_frequency_Hz"]
         self.linear_damping_ratio: float = data["linear_damping_ratio"]
-
-    def column(self, name: str) -> np.ndarray:
-        try:
-            return self.table[:, self.columns.index(name)]
-        except ValueError:
-            raise KeyError(f"no column {name!r}; columns are: {', '.join(self.columns)}") from None
 
     @property
     def amplitude(self) -> np.ndarray:
@@ -224,9 +226,6 @@ class Backbone:
         import pandas as pd
 
         return pd.DataFrame(self.table, columns=self.columns)
-
-    def __len__(self) -> int:
-        return self.table.shape[0]
 
     def __repr__(self) -> str:
         f = self.frequency_hz
