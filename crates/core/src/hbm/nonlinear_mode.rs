@@ -40,9 +40,9 @@
 //! R_a = X_1ᴴ M X_1 / a² − 1 = |η_1|² / a² + Σ_{r≠*} |p_r1|² / a² − 1,    p_r1 = −a_rᵀ G_1 / den_r(Ω; ξ)
 //! ```
 //!
-//! (with a damping matrix, `p_r1 = −W_r0 η_1 − W_rG G_1`, below), so that `a` measures the motion, not only the target mode's share of it, which falls where
-//! slipping joints move the other modes (on a model with many modes it can even fall while the
-//! motion grows). The continuation parameter is `λ = log10 a`, so a branch spans decades of
+//! (with a damping matrix, `p_r1 = −W_r0 η_1 − W_rG G_1`, below), so that `a` measures the
+//! motion, not only the target mode's share of it, which falls where slipping joints move the
+//! other modes (on a model with many modes it can even fall while the motion grows). The continuation parameter is `λ = log10 a`, so a branch spans decades of
 //! amplitude with steps of even relative size.
 //!
 //! # A damping matrix
@@ -548,11 +548,7 @@ impl<'m> NonlinearMode<'m> {
     /// The damping that `−ξ` acts on, `S_rs`: the identity with
     /// [`NegativeDamping::MassProportional`], the target mode alone otherwise.
     fn shifted(&self, r: usize, s: usize) -> f64 {
-        match (self.shift_all, r == s, r == self.target) {
-            (_, false, _) => 0.0,
-            (true, true, _) | (false, true, true) => 1.0,
-            (false, true, false) => 0.0,
-        }
+        f64::from(r == s && (self.shift_all || r == self.target))
     }
 
     /// The condensed modes at harmonic k with a damping matrix: with the modal dynamic stiffness
@@ -562,6 +558,15 @@ impl<'m> NonlinearMode<'m> {
     /// diagonal in the modes, `W_r0 = 0`, `W_rj = a_jr / den_r` and `z_k` the target's own
     /// dynamic stiffness, in closed form.
     fn coupling_at(&self, k: usize, omega: f64, xi: f64) -> ([Mat<c64>; 3], [c64; 3]) {
+        let (q, m) = (self.q, self.omega_r.len());
+        let mut w = [Mat::zeros(m, q + 1), Mat::zeros(m, q + 1), Mat::zeros(m, q + 1)];
+        let z = self.coupling_into(k, omega, xi, true, &mut w);
+        (w, z)
+    }
+
+    /// [`Self::coupling_at`] into `w` (three m × (1 + q) matrices, the target's row left as it
+    /// is, zero); without `derivatives`, `w[1]`, `w[2]` and `z[1..]` are not computed.
+    fn coupling_into(&self, k: usize, omega: f64, xi: f64, derivatives: bool, w: &mut [Mat<c64>; 3]) -> [c64; 3] {
         let (q, m, t) = (self.q, self.omega_r.len(), self.target);
         let (kf, kw) = (k as f64, k as f64 * omega);
         let zero = c64::new(0.0, 0.0);
@@ -579,21 +584,24 @@ impl<'m> NonlinearMode<'m> {
             c64::new(diag, kf * (damping(r, s) - xi * self.shifted(r, s)))
         };
         let dz_xi = |r: usize, s: usize| c64::new(0.0, -kw * self.shifted(r, s));
-        let mut w = [Mat::zeros(m, q + 1), Mat::zeros(m, q + 1), Mat::zeros(m, q + 1)];
-        let rest: Vec<usize> = (0..m).filter(|&r| r != t).collect();
         if self.coupled.is_none() || k == 0 {
-            for &r in &rest {
-                let den = z(r, r);
-                let (dw, dx) = (dz_omega(r, r), dz_xi(r, r));
+            // `W_rj = a_jr / den_r`, `∂W = −W ∂den / den`: one division a mode.
+            for r in (0..m).filter(|&r| r != t) {
+                let inv = c64::new(1.0, 0.0) / z(r, r);
+                let (dw, dx) = (dz_omega(r, r) * inv, dz_xi(r, r) * inv);
+                w[0][(r, 0)] = zero;
                 for j in 0..q {
-                    let v = c64::new(self.a_all[(j, r)], 0.0) / den;
+                    let v = inv * self.a_all[(j, r)];
                     w[0][(r, j + 1)] = v;
-                    w[1][(r, j + 1)] = -v * dw / den;
-                    w[2][(r, j + 1)] = -v * dx / den;
+                    if derivatives {
+                        w[1][(r, j + 1)] = -v * dw;
+                        w[2][(r, j + 1)] = -v * dx;
+                    }
                 }
             }
-            return (w, [z(t, t), dz_omega(t, t), dz_xi(t, t)]);
+            return [z(t, t), dz_omega(t, t), dz_xi(t, t)];
         }
+        let rest: Vec<usize> = (0..m).filter(|&r| r != t).collect();
         let n = rest.len();
         let zrr = Mat::from_fn(n, n, |i, j| z(rest[i], rest[j]));
         let rhs =
@@ -604,20 +612,22 @@ impl<'m> NonlinearMode<'m> {
             );
         let lu = zrr.partial_piv_lu();
         let sol = lu.solve(&rhs);
-        let mut out = [c64::new(0.0, 0.0); 3];
+        let mut out = [zero; 3];
         out[0] = z(t, t) - (0..n).map(|i| z(t, rest[i]) * sol[(i, 0)]).sum::<c64>();
-        for (d, dz) in [(1usize, &dz_omega as &dyn Fn(usize, usize) -> c64), (2, &dz_xi)] {
-            // dW = Z_rr⁻¹ ([dZ_r*, 0] − dZ_rr W).
-            let drhs = Mat::from_fn(n, q + 1, |i, j| {
-                let own = if j == 0 { dz(rest[i], t) } else { zero };
-                own - (0..n).map(|l| dz(rest[i], rest[l]) * sol[(l, j)]).sum::<c64>()
-            });
-            let dsol = lu.solve(&drhs);
-            out[d] =
-                dz(t, t) - (0..n).map(|i| dz(t, rest[i]) * sol[(i, 0)] + z(t, rest[i]) * dsol[(i, 0)]).sum::<c64>();
-            for (i, &r) in rest.iter().enumerate() {
-                for j in 0..=q {
-                    w[d][(r, j)] = dsol[(i, j)];
+        if derivatives {
+            for (d, dz) in [(1usize, &dz_omega as &dyn Fn(usize, usize) -> c64), (2, &dz_xi)] {
+                // dW = Z_rr⁻¹ ([dZ_r*, 0] − dZ_rr W).
+                let drhs = Mat::from_fn(n, q + 1, |i, j| {
+                    let own = if j == 0 { dz(rest[i], t) } else { zero };
+                    own - (0..n).map(|l| dz(rest[i], rest[l]) * sol[(l, j)]).sum::<c64>()
+                });
+                let dsol = lu.solve(&drhs);
+                out[d] =
+                    dz(t, t) - (0..n).map(|i| dz(t, rest[i]) * sol[(i, 0)] + z(t, rest[i]) * dsol[(i, 0)]).sum::<c64>();
+                for (i, &r) in rest.iter().enumerate() {
+                    for j in 0..=q {
+                        w[d][(r, j)] = dsol[(i, j)];
+                    }
                 }
             }
         }
@@ -626,7 +636,7 @@ impl<'m> NonlinearMode<'m> {
                 w[0][(r, j)] = sol[(i, j)];
             }
         }
-        (w, out)
+        out
     }
 
     /// The linear part at Ω and ξ for every harmonic: `H_k` (into `h`, with its derivatives),
@@ -662,21 +672,10 @@ impl<'m> NonlinearMode<'m> {
                 dx.col_iter_mut().flat_map(|c| c.iter_mut()).for_each(|v| *v = -*v);
                 self.coupling[k].z = self.target_stiffness(k, omega, xi);
             }
-            // Harmonic 1's W in place: `W_rj = a_jr / den_r`, one division a mode.
-            let shift = if self.shift_all { xi } else { 0.0 };
-            let [w, dw, dx] = &mut self.w1;
-            for r in (0..m).filter(|&r| r != t) {
-                let c = self.c_r[r] - shift;
-                let inv = c64::new(1.0, 0.0) / c64::new(self.omega_r[r] * self.omega_r[r] - omega * omega, omega * c);
-                let (d_omega, d_xi) =
-                    (c64::new(-2.0 * omega, c) * inv, c64::new(0.0, if self.shift_all { -omega } else { 0.0 }) * inv);
-                for j in 0..q {
-                    let v = inv * self.a_all[(j, r)];
-                    w[(r, j + 1)] = v;
-                    dw[(r, j + 1)] = -v * d_omega;
-                    dx[(r, j + 1)] = -v * d_xi;
-                }
-            }
+            // Harmonic 1's W in place (the closed form, no allocation).
+            let mut w1 = std::mem::replace(&mut self.w1, [Mat::zeros(0, 0), Mat::zeros(0, 0), Mat::zeros(0, 0)]);
+            self.coupling_into(1, omega, xi, true, &mut w1);
+            self.w1 = w1;
             return;
         }
         for k in 0..=nh {
@@ -705,8 +704,11 @@ impl<'m> NonlinearMode<'m> {
                     }
                     cp.c[d][i] = if d == 0 { c64::new(self.a_t[i], 0.0) - ci } else { -ci };
                 }
-                let target = [&mut self.h[k], &mut self.dh_domega[k], &mut self.dh_dxi[k]];
-                let hk = target.into_iter().nth(d).expect("three parts");
+                let hk = match d {
+                    0 => &mut self.h[k],
+                    1 => &mut self.dh_domega[k],
+                    _ => &mut self.dh_dxi[k],
+                };
                 for i in 0..q {
                     for j in 0..q {
                         hk[(i, j)] = (0..m).map(|r| w[d][(r, j + 1)] * self.a_all[(i, r)]).sum();
@@ -743,12 +745,11 @@ impl<'m> NonlinearMode<'m> {
         // Modal coordinates of every mode, harmonic by harmonic: η for the target,
         // `−W_r0 η_k − Σ_j W_rj G_kj` for the others (the condensed modes, recovered).
         let mut modal = vec![vec![c64::new(0.0, 0.0); nh + 1]; m];
-        let shift = if self.shift_all { xi } else { 0.0 };
+        let mut w = [Mat::zeros(m, q + 1), Mat::zeros(0, 0), Mat::zeros(0, 0)];
         for k in 0..=nh {
-            // W of this harmonic: by the LU of the other modes with a damping matrix, else the
-            // modal sum's `a_jr / den_r` (W_r0 = 0), without derivatives.
-            let w = self.coupled.as_ref().map(|_| self.coupling_at(k, omega, xi).0);
-            let kw = k as f64 * omega;
+            // W of this harmonic (the closed form, or the LU of the other modes with a damping
+            // matrix), without derivatives.
+            self.coupling_into(k, omega, xi, false, &mut w);
             let gk: Vec<c64> = (0..q)
                 .map(|i| {
                     if k == 0 {
@@ -764,13 +765,10 @@ impl<'m> NonlinearMode<'m> {
                 c64::new(self.eta(y, cos_index(k)), -self.eta(y, sin_index(k))) * amplitude
             };
             for r in 0..m {
-                modal[r][k] = match &w {
-                    _ if r == self.target => eta,
-                    Some(w) => -w[0][(r, 0)] * eta - (0..q).map(|i| w[0][(r, i + 1)] * gk[i]).sum::<c64>(),
-                    None => {
-                        let den = c64::new(self.omega_r[r] * self.omega_r[r] - kw * kw, kw * (self.c_r[r] - shift));
-                        -(0..q).map(|i| gk[i] * self.a_all[(i, r)]).sum::<c64>() / den
-                    }
+                modal[r][k] = if r == self.target {
+                    eta
+                } else {
+                    -w[0][(r, 0)] * eta - (0..q).map(|i| w[0][(r, i + 1)] * gk[i]).sum::<c64>()
                 };
             }
         }
