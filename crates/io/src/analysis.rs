@@ -451,7 +451,6 @@ impl<'a> LevelSweeper<'a> {
                     level_n: level,
                     kind: b.kind.name().to_string(),
                     frequency_hz: b.omega / TWO_PI,
-                    amplitudes: result.outputs.iter().map(|o| (o.name.clone(), o.harmonic(1).0)).collect(),
                     harmonics: result
                         .outputs
                         .iter()

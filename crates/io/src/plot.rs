@@ -313,7 +313,7 @@ pub fn plot_frf(path: &Path, levels: &[LevelResult], output: &str) -> Result<(),
             dashed: l.points.iter().map(is_unstable).collect(),
         });
         for b in &l.bifurcations {
-            if let Some((_, a)) = b.amplitudes.iter().find(|(name, _)| name == output) {
+            if let Some((_, a)) = b.amplitudes().find(|(name, _)| *name == output) {
                 markers.push(Marker { x: b.frequency_hz, y: a / l.level_n, label: bifurcation_symbol(&b.kind).into() });
             }
         }
@@ -1198,7 +1198,6 @@ mod tests {
                 level_n,
                 kind: "fold".into(),
                 frequency_hz: 105.0,
-                amplitudes: vec![("mass".into(), harmonics[1].0)],
                 harmonics: vec![("mass".into(), harmonics)],
                 exponent_im: 0.0,
                 located: true,

@@ -600,7 +600,7 @@ fn bifurcation_section(h: &mut String, data: &ReportData) {
     }
     h.push_str("<table>\n<tr><th>level (N)</th><th>kind</th><th>frequency (Hz)</th><th>|X<sub>1</sub>| at the outputs (m)</th></tr>\n");
     for b in &data.bifurcations {
-        let amplitudes: Vec<String> = b.amplitudes.iter().map(|(o, a)| format!("{}: {}", escape(o), sig(*a))).collect();
+        let amplitudes: Vec<String> = b.amplitudes().map(|(o, a)| format!("{}: {}", escape(o), sig(a))).collect();
         let _ = writeln!(
             h,
             "<tr><td class=\"num\">{}</td><td>{}{}</td><td class=\"num\">{}</td><td>{}</td></tr>",
@@ -886,7 +886,6 @@ mod tests {
             level_n: 100.0,
             kind: "fold".into(),
             frequency_hz: 241.25,
-            amplitudes: vec![("mass".into(), 2.5e-4)],
             harmonics: vec![("mass".into(), vec![(0.0, 0.0), (2.5e-4, -1.2)])],
             exponent_im: 0.0,
             located: true,

@@ -273,14 +273,13 @@ fn unstable_stretches_are_drawn_dashed_and_bifurcations_marked() {
         p.stability = Some(PointStability { stable, exponent_re: if stable { -1.0 } else { 1.0 }, exponent_im: 0.0 });
     }
     for f in [240.0, 260.0] {
-        // On the curve: |X₁| = (|X₁|/F) × F, and the point's harmonics.
+        // On the curve: the point's harmonics (its |X₁| is (|X₁|/F) × F).
         let point = &levels[1].points.iter().find(|p| p.frequency_hz == f).unwrap().outputs[0];
-        let (on_curve, harmonics) = (point.disp_frf * 1000.0, point.harmonics.clone());
+        let harmonics = point.harmonics.clone();
         levels[1].bifurcations.push(BifurcationRecord {
             level_n: 1000.0,
             kind: "fold".into(),
             frequency_hz: f,
-            amplitudes: vec![("mass".into(), on_curve)],
             harmonics: vec![("mass".into(), harmonics)],
             exponent_im: 0.0,
             located: true,

@@ -7,7 +7,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use stickslip_core::continuation::Point;
-use stickslip_core::continuation::TerminationReason;
 use stickslip_core::timesim::{steady_state, SteadyStateOptions};
 use stickslip_io::analysis::{backbone_ending, run_nonlinear_mode, LevelRun, LevelSweeper};
 use stickslip_io::backbone::{backbone_columns, backbone_rows, singular_kind_name};
@@ -248,8 +247,7 @@ impl PyStudy {
             })
             .collect::<PyResult<Vec<_>>>()?;
         d.set_item("bifurcations", bifurcations)?;
-        let complete =
-            matches!(backbone.termination, TerminationReason::ReachedEnd) && backbone.turned_back_at.is_none();
+        let complete = backbone.complete();
         d.set_item("complete", complete)?;
         d.set_item("ending", backbone_ending(&backbone))?;
         d.set_item("notes", backbone.notes.clone())?;

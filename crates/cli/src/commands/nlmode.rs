@@ -129,7 +129,7 @@ pub fn compute_and_write(
             if plots.is_some() { ", backbone_frequency and backbone_damping plots" } else { "" }
         );
     }
-    if !matches!(backbone.termination, stickslip_core::continuation::TerminationReason::ReachedEnd) {
+    if !backbone.complete() {
         anyhow::bail!("nonlinear mode: the branch {} (its points are written)", backbone_ending(&backbone));
     }
     Ok(files)

@@ -326,6 +326,12 @@ pub struct SynthesisedPoint {
 }
 
 impl Backbone {
+    /// Did the branch reach the last amplitude? (A backbone that turned back at a branch point
+    /// came back to the first one instead.)
+    pub fn complete(&self) -> bool {
+        self.termination == TerminationReason::ReachedEnd
+    }
+
     /// The forced response near the mode's resonance under `level · load cos Ωt`, from the
     /// backbone alone (single nonlinear mode theory, Krack 2015, Section 5): the structure is
     /// assumed to move in the nonlinear mode, whose amplitude `a` answers the force as

@@ -371,7 +371,7 @@ pub fn write_bifurcations_csv(path: &Path, levels: &[LevelResult]) -> Result<(),
     }
     text.push('\n');
     for b in levels.iter().flat_map(|l| &l.bifurcations) {
-        let values = [b.frequency_hz, b.exponent_im].into_iter().chain(b.amplitudes.iter().map(|a| a.1));
+        let values = [b.frequency_hz, b.exponent_im].into_iter().chain(b.amplitudes().map(|a| a.1));
         for value in values {
             if !value.is_finite() {
                 return Err(OutputError::NotFinite {
@@ -384,7 +384,7 @@ pub fn write_bifurcations_csv(path: &Path, levels: &[LevelResult]) -> Result<(),
         }
         let _ =
             write!(text, "{:e},{},{:e},{},{:e}", b.level_n, b.kind, b.frequency_hz, u8::from(b.located), b.exponent_im);
-        for (_, a) in &b.amplitudes {
+        for (_, a) in b.amplitudes() {
             let _ = write!(text, ",{a:e}");
         }
         text.push('\n');

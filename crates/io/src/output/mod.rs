@@ -96,18 +96,21 @@ pub struct BifurcationRecord {
     /// "fold", "branch point", "period doubling" or "Neimark-Sacker".
     pub kind: String,
     pub frequency_hz: f64,
-    /// |X₁| at each output there (m), in the outputs' order.
-    pub amplitudes: Vec<(String, f64)>,
     /// The harmonics at each output there, in the outputs' order: element k of each list is
-    /// `(A_k, φ_k)`, amplitude (m) and phase (rad), k = 0..=N, as [`OutputRecord::harmonics`]
-    /// (so `harmonics[i].1[1].0` is `amplitudes[i].1`). Empty when not known (a record made
-    /// elsewhere than by the sweep): the phase and harmonics plots then leave it unmarked.
+    /// `(A_k, φ_k)`, amplitude (m) and phase (rad), k = 0..=N, as [`OutputRecord::harmonics`].
     pub harmonics: Vec<(String, Vec<(f64, f64)>)>,
     /// Imaginary part of the crossing Floquet exponent (rad/s): 0 at a fold or a branch point
     /// (a real exponent crosses zero there).
     pub exponent_im: f64,
     /// False when it could not be located between its two points (then it is the second).
     pub located: bool,
+}
+
+impl BifurcationRecord {
+    /// |X₁| at each output there (m), in the outputs' order.
+    pub fn amplitudes(&self) -> impl Iterator<Item = (&str, f64)> {
+        self.harmonics.iter().map(|(name, h)| (name.as_str(), h.get(1).map_or(0.0, |h| h.0)))
+    }
 }
 
 /// Response of one output at one point.
